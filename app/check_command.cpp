@@ -1,0 +1,59 @@
+#include <cstdio>
+
+#include "app/commands.h"
+#include "app/scene_loading.h"
+#include "sim/core/parallel.h"
+#include "sim/solver/solver.h"
+
+namespace shellmpm {
+
+int check_command(const CommonArgs& a) {
+  LoadedScene ls = load_scene_for_cli(a, "", "");
+  const Scene& scene = ls.scene;
+  ThreadLimit limit(scene.shot.threads);
+  Solver solver(scene);
+  const ShotSettings& s = scene.shot;
+  std::printf("scene %s: valid\n", scene.path.c_str());
+  std::printf("frames %d-%d at %g fps, dx %g m, domain [%g %g %g]..[%g %g %g]\n", s.frame_start,
+              s.frame_end, s.fps, s.dx, s.domain_min.x(), s.domain_min.y(), s.domain_min.z(),
+              s.domain_max.x(), s.domain_max.y(), s.domain_max.z());
+  std::string stages;
+  for (const std::string& n : solver.stage_names()) stages += (stages.empty() ? "" : ", ") + n;
+  std::printf("stages: %s\n", stages.empty() ? "(none: nothing to simulate)" : stages.c_str());
+  std::size_t emitted = 0;
+  for (std::size_t i = 0; i < scene.sources.size(); ++i) {
+    const SourceDesc& src = scene.sources[i];
+    if (!src.emit) continue;
+    // Flow over the window: lattice points leaving the shape, estimated by a dry run.
+    const SourceSampler& sm = solver.samplers()[i];
+    const double step = 1.0 / s.fps;
+    for (double t = sm.emit_t0(); t < sm.emit_t1(); t += step)
+      sm.emit(t, std::min(step, sm.emit_t1() - t), [&](const Vec3d&) { ++emitted; });
+  }
+  const std::size_t n0 = solver.particles().size();
+  std::printf("particles: %zu at start, about %zu more emitted\n", n0, emitted);
+  // Bin once to count grid blocks (no simulation).
+  SparseGrid grid;
+  grid.setup(s.dx, s.domain_min);
+  grid.bin(solver.particles().x);
+  std::printf("grid blocks: %zu (4x4x4 nodes) around %zu particle blocks\n", grid.num_grid_blocks(),
+              grid.num_particle_blocks());
+  const double per_particle = static_cast<double>(solver.particles().bytes()) /
+                                  std::max<std::size_t>(n0, 1) + 8.0;
+  const double mem = per_particle * static_cast<double>(n0 + emitted) +
+                     static_cast<double>(grid.bytes()) * (n0 + emitted) / std::max<std::size_t>(n0, 1);
+  std::printf("memory: about %.1f MiB\n", mem / (1024.0 * 1024.0));
+  const double dt = solver.stable_dt();
+  const double steps = std::ceil(1.0 / s.fps / dt);
+  // Throughput from bench/mpm_throughput on the reference machine, per thread.
+  constexpr double kParticleStepsPerSecondPerThread = 2.5e6;
+  const int threads = ThreadLimit::active();
+  const double sec = steps * static_cast<double>(n0 + emitted) /
+                     (kParticleStepsPerSecondPerThread * threads);
+  std::printf("time step at start: %.3g s (%g substeps per frame)\n", dt, steps);
+  std::printf("estimated time per frame: %.2f s on %d threads (at %.1fM particle-steps/s/thread)\n",
+              sec, threads, kParticleStepsPerSecondPerThread / 1e6);
+  return kExitOk;
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,70 @@
+// shellmpm: command line entry. Parses arguments and hands over to a subcommand.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "app/commands.h"
+#include "io/user_error.h"
+#include "sim/core/check.h"
+#include "sim/solver/solver.h"
+
+namespace {
+
+using namespace shellmpm;
+
+void add_common(CLI::App* cmd, CommonArgs& a) {
+  cmd->add_option("SCENE", a.scene, "scene file (YAML or JSON)")->required();
+  cmd->add_option("--set", a.overrides, "override a scene key: key.path=value (repeatable)")
+      ->take_all()
+      ->allow_extra_args(false);
+  cmd->add_option("--threads", a.threads, "worker threads (0 = all cores; default: scene)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag_callback("--quiet,-q", [&a] { a.verbosity = Verbosity::Quiet; }, "errors only");
+  cmd->add_flag_callback("--verbose,-v", [&a] { a.verbosity = Verbosity::Verbose; },
+                         "per-frame stage timings and energies");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"shellmpm: thin shells and MPM materials with frictional contact"};
+  app.set_version_flag("--version", std::string("shellmpm ") + SHELLMPM_VERSION);
+  app.require_subcommand(1);
+
+  RunArgs run;
+  CLI::App* run_cmd = app.add_subcommand("run", "simulate a scene and write its caches");
+  add_common(run_cmd, run);
+  run_cmd->add_option("--frames", run.frames, "frame range A-B (or one frame A)");
+  run_cmd->add_option("--output,-o", run.output, "output directory (replaces output.directory)");
+  run_cmd->add_flag("--resume", run.resume, "continue from the newest checkpoint in the output directory");
+
+  CommonArgs check;
+  CLI::App* check_cmd = app.add_subcommand(
+      "check", "validate a scene; print its stages, particle and grid counts, memory and time estimates");
+  add_common(check_cmd, check);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? kExitOk : kExitUserError;
+  }
+  try {
+    if (*run_cmd) return run_command(run);
+    if (*check_cmd) return check_command(check);
+  } catch (const UserError& e) {
+    std::fprintf(stderr, "\nerror: %s\n", e.what());
+    return kExitUserError;
+  } catch (const SimulationError& e) {
+    std::fprintf(stderr, "\nsimulation stopped: %s\n", e.what());
+    return kExitSimulation;
+  } catch (const InvariantError& e) {
+    std::fprintf(stderr, "\n%s\nthis is a bug in shellmpm; please report it with the scene file\n",
+                 e.what());
+    return kExitInternal;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "\nerror: %s\n", e.what());
+    return kExitSimulation;
+  }
+  return kExitOk;
+}

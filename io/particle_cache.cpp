@@ -1,0 +1,34 @@
+#include "io/particle_cache.h"
+
+#include <cstring>
+#include <fstream>
+#include <system_error>
+#include <vector>
+
+#include "io/atomic_file.h"
+
+namespace shellmpm {
+
+void write_particle_ply(const std::string& path, const ParticleSet& p) {
+  const std::size_t n = p.size();
+  std::string header = "ply\nformat binary_little_endian 1.0\ncomment shellmpm particle cache\n";
+  header += "element vertex " + std::to_string(n) + "\n";
+  for (const char* a : {"x", "y", "z", "vx", "vy", "vz"}) header += std::string("property float ") + a + "\n";
+  header += "property uint id\nend_header\n";
+  constexpr std::size_t kRecord = 6 * 4 + 4;
+  std::vector<char> body(n * kRecord);
+  for (std::size_t i = 0; i < n; ++i) {
+    float r[6] = {float(p.x[i].x()), float(p.x[i].y()), float(p.x[i].z()),
+                  float(p.v[i].x()), float(p.v[i].y()), float(p.v[i].z())};
+    std::memcpy(body.data() + i * kRecord, r, 24);
+    std::memcpy(body.data() + i * kRecord + 24, &p.id[i], 4);
+  }
+  write_file_atomic(path, [&](const std::string& tmp) {
+    std::ofstream f(tmp, std::ios::binary);
+    f.write(header.data(), static_cast<std::streamsize>(header.size()));
+    f.write(body.data(), static_cast<std::streamsize>(body.size()));
+    if (!f) throw std::system_error(errno, std::generic_category(), "writing " + tmp);
+  });
+}
+
+}  // namespace shellmpm

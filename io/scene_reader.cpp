@@ -1,0 +1,1276 @@
+// Scene file reader: YAML/JSON -> a private document tree (values keep their file and line,
+// or the --set override they came from) -> overrides applied -> validated into a Scene.
+// Every key is looked up in scene_schema(); types, defaults and numeric ranges are checked
+// from the schema itself, so the schema, the reader and docs/scene-format.md cannot drift.
+#include "io/scene_reader.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <unordered_map>
+#include <utility>
+
+#include "sim/core/check.h"
+
+namespace shellmpm {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ------------------------------------------------------------------------------------------
+// Schema
+// ------------------------------------------------------------------------------------------
+
+/// Builder for one KeySpec, so the schema table below reads like the documentation.
+class Spec {
+ public:
+  Spec(std::string key, KeyType type) {
+    k_.key = std::move(key);
+    k_.type = type;
+  }
+  Spec& required() {
+    k_.presence = Presence::Required;
+    return *this;
+  }
+  Spec& def(std::string yaml) {
+    k_.presence = Presence::Default;
+    k_.default_value = std::move(yaml);
+    return *this;
+  }
+  Spec& optional(std::string prose) {
+    k_.presence = Presence::Optional;
+    k_.default_value = std::move(prose);
+    return *this;
+  }
+  Spec& unit(std::string u) {
+    k_.unit = std::move(u);
+    return *this;
+  }
+  Spec& gt(double v) { return lower(v, true); }
+  Spec& ge(double v) { return lower(v, false); }
+  Spec& lt(double v) { return upper(v, true); }
+  Spec& le(double v) { return upper(v, false); }
+  Spec& choices(std::vector<std::string> c) {
+    k_.choices = std::move(c);
+    return *this;
+  }
+  Spec& only_for(std::vector<std::string> types) {
+    k_.only_for = std::move(types);
+    return *this;
+  }
+  Spec& nonempty() {
+    k_.nonempty = true;
+    return *this;
+  }
+  Spec& unit_vector() {
+    k_.unit_vector = true;
+    return *this;
+  }
+  Spec& rule(std::string r) {
+    k_.rule = std::move(r);
+    return *this;
+  }
+  operator KeySpec() const { return k_; }  // NOLINT: implicit by design (table syntax)
+
+ private:
+  Spec& lower(double v, bool open) {
+    k_.min = v;
+    k_.min_open = open;
+    return *this;
+  }
+  Spec& upper(double v, bool open) {
+    k_.max = v;
+    k_.max_open = open;
+    return *this;
+  }
+  KeySpec k_;
+};
+
+using T = KeyType;
+
+std::vector<KeySpec> build_schema() {
+  const std::vector<std::string> kShapeTypes = {"plane", "box", "sphere", "cylinder", "mesh"};
+  return {
+      // top level
+      Spec("version", T::Int).required().ge(1).le(1),
+      Spec("shot", T::Map).required(),
+      Spec("materials", T::List).def("[]"),
+      Spec("sources", T::List).def("[]"),
+      Spec("colliders", T::List).def("[]"),
+      Spec("output", T::Map).def("{}"),
+      // shot
+      Spec("shot.frames", T::FrameRange).def("[1, 48]").ge(1),
+      Spec("shot.fps", T::Number).def("24").unit("1/s").gt(0),
+      Spec("shot.cfl", T::Number).def("0.3").gt(0).le(1),
+      Spec("shot.dt_min", T::Number).def("1e-6").unit("s").gt(0),
+      Spec("shot.dt_max", T::Number).def("1e-2").unit("s").gt(0).rule(">= dt_min"),
+      Spec("shot.gravity", T::Vec3).def("[0, -9.81, 0]").unit("m/s^2"),
+      Spec("shot.domain", T::Map).required(),
+      Spec("shot.domain.min", T::Vec3).required().unit("m"),
+      Spec("shot.domain.max", T::Vec3).required().unit("m").rule("> min on every axis"),
+      Spec("shot.dx", T::Number).required().unit("m").gt(0).rule("at most 2^20 cells per axis"),
+      Spec("shot.threads", T::Int).def("0").ge(0),
+      Spec("shot.transfer", T::Enum).def("apic").choices({"apic", "mls"}),
+      Spec("shot.units", T::String).def("m").nonempty(),
+      // materials
+      Spec("materials[].name", T::String).required().nonempty().rule("unique"),
+      Spec("materials[].type", T::Enum).required().choices({"elastic", "sand", "snow"}),
+      Spec("materials[].model", T::Enum)
+          .def("fixed_corotated")
+          .choices({"fixed_corotated", "neo_hookean"})
+          .only_for({"elastic"}),
+      Spec("materials[].youngs_modulus", T::Number).def("1e5").unit("Pa").gt(0),
+      Spec("materials[].poisson_ratio", T::Number).def("0.3").ge(0).lt(0.5),
+      Spec("materials[].density", T::Number).def("1000").unit("kg/m^3").gt(0),
+      Spec("materials[].friction_angle", T::Number)
+          .def("30")
+          .unit("deg")
+          .ge(0)
+          .lt(90)
+          .only_for({"sand"}),
+      Spec("materials[].cohesion", T::Number).def("0").ge(0).only_for({"sand"}),
+      Spec("materials[].critical_compression", T::Number)
+          .def("0.025")
+          .gt(0)
+          .lt(1)
+          .only_for({"snow"}),
+      Spec("materials[].critical_stretch", T::Number).def("0.0075").gt(0).only_for({"snow"}),
+      Spec("materials[].hardening", T::Number).def("10").ge(0).only_for({"snow"}),
+      // sources
+      Spec("sources[].name", T::String)
+          .optional("`source<i>` (i = list index)")
+          .nonempty()
+          .rule("unique"),
+      Spec("sources[].material", T::String).required().rule("a name in materials"),
+      Spec("sources[].shape", T::Shape).required().rule("not a plane"),
+      Spec("sources[].particles_per_cell", T::Number).def("8").gt(0).le(64),
+      Spec("sources[].velocity", T::Vec3).def("[0, 0, 0]").unit("m/s"),
+      Spec("sources[].seed", T::Int).def("1").ge(0).le(4294967295.0),
+      Spec("sources[].emit", T::Map)
+          .optional("none: fill once at the start")
+          .rule("velocity must be nonzero"),
+      Spec("sources[].emit.frames", T::FrameRange).required().ge(1),
+      // colliders
+      Spec("colliders[].name", T::String)
+          .optional("`collider<i>` (i = list index)")
+          .nonempty()
+          .rule("unique"),
+      Spec("colliders[].shape", T::Shape).required(),
+      Spec("colliders[].boundary", T::Enum).def("separate").choices({"sticky", "slip", "separate"}),
+      Spec("colliders[].friction", T::Number).def("0").ge(0),
+      Spec("colliders[].keyframes", T::List).def("[]").rule("times strictly increase"),
+      Spec("colliders[].keyframes[].time", T::Number)
+          .optional("give time or frame")
+          .unit("s")
+          .ge(0),
+      Spec("colliders[].keyframes[].frame", T::Int).optional("give time or frame").ge(1),
+      Spec("colliders[].keyframes[].translate", T::Vec3).def("[0, 0, 0]").unit("m"),
+      Spec("colliders[].keyframes[].rotate", T::Vec3).def("[0, 0, 0]").unit("deg"),
+      // output
+      Spec("output.directory", T::String).def("out").nonempty(),
+      Spec("output.density", T::Bool).def("true"),
+      Spec("output.density_pattern", T::String)
+          .def("density.####.vdb")
+          .rule("exactly one run of `#`"),
+      Spec("output.velocity", T::Bool).def("false"),
+      Spec("output.half_float", T::Bool).def("false"),
+      Spec("output.voxel_size", T::Number).def("0").unit("m").ge(0),
+      Spec("output.particles", T::Bool).def("false"),
+      Spec("output.particles_pattern", T::String)
+          .def("particles.####.ply")
+          .rule("exactly one run of `#`"),
+      Spec("output.stats", T::String).def("stats.json").nonempty(),
+      Spec("output.checkpoint_every", T::Int).def("0").ge(0),
+      // shapes (the value of sources[].shape and colliders[].shape)
+      Spec("shape.type", T::Enum).required().choices(kShapeTypes),
+      Spec("shape.min", T::Vec3).required().unit("m").only_for({"box"}),
+      Spec("shape.max", T::Vec3).required().unit("m").only_for({"box"}).rule("> min on every axis"),
+      Spec("shape.center", T::Vec3).required().unit("m").only_for({"sphere", "cylinder"}),
+      Spec("shape.radius", T::Number).required().unit("m").gt(0).only_for({"sphere", "cylinder"}),
+      Spec("shape.axis", T::Vec3).required().unit_vector().only_for({"cylinder"}),
+      Spec("shape.height", T::Number).required().unit("m").gt(0).only_for({"cylinder"}),
+      Spec("shape.point", T::Vec3).required().unit("m").only_for({"plane"}),
+      Spec("shape.normal", T::Vec3).required().unit_vector().only_for({"plane"}),
+      Spec("shape.path", T::String)
+          .required()
+          .nonempty()
+          .only_for({"mesh"})
+          .rule("readable file; relative to the scene file"),
+      Spec("shape.scale", T::Number).def("1").gt(0).only_for({"mesh"}),
+      Spec("shape.translate", T::Vec3).def("[0, 0, 0]").unit("m").only_for({"mesh"}),
+  };
+}
+
+const std::unordered_map<std::string, const KeySpec*>& schema_index() {
+  static const std::unordered_map<std::string, const KeySpec*> index = [] {
+    std::unordered_map<std::string, const KeySpec*> m;
+    for (const KeySpec& s : scene_schema()) m.emplace(s.key, &s);
+    return m;
+  }();
+  return index;
+}
+
+const KeySpec* find_spec(const std::string& key) {
+  auto it = schema_index().find(key);
+  return it == schema_index().end() ? nullptr : it->second;
+}
+
+std::string join_key(const std::string& prefix, const std::string& name) {
+  return prefix.empty() ? name : prefix + "." + name;
+}
+
+/// The schema prefix under which a key's children (or list items' keys) live.
+std::string child_prefix(const KeySpec& s) {
+  if (s.type == KeyType::Shape) return "shape";
+  if (s.type == KeyType::List) return s.key + "[]";
+  return s.key;
+}
+
+/// Names of the keys directly under `prefix`, in schema order; with `variant`, only those
+/// allowed for that block type.
+std::string known_keys(const std::string& prefix, const std::string* variant) {
+  std::string out;
+  const std::string head = prefix.empty() ? "" : prefix + ".";
+  for (const KeySpec& s : scene_schema()) {
+    if (s.key.compare(0, head.size(), head) != 0) continue;
+    const std::string rest = s.key.substr(head.size());
+    if (rest.find_first_of(".[") != std::string::npos) continue;
+    if (variant && !s.only_for.empty() &&
+        std::find(s.only_for.begin(), s.only_for.end(), *variant) == s.only_for.end()) {
+      continue;
+    }
+    out += (out.empty() ? "" : ", ") + rest;
+  }
+  return out.empty() ? "none" : out;
+}
+
+std::string join(const std::vector<std::string>& v, const char* sep = ", ") {
+  std::string out;
+  for (const std::string& s : v) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+/// Shortest text that reads back as the same double ("0.5", "90", "4294967295", "1e-6").
+std::string fmt_num(double x) {
+  char buf[64];
+  if (x == std::floor(x) && std::fabs(x) < 1e15) {
+    std::snprintf(buf, sizeof buf, "%.0f", x);
+    return buf;
+  }
+  for (int prec = 1; prec <= 17; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*g", prec, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  std::string s = buf;  // "1e-06" -> "1e-6", "1e+20" -> "1e20"
+  const std::size_t e = s.find('e');
+  if (e != std::string::npos) {
+    std::size_t d = e + 1;
+    if (s[d] == '+') s.erase(d, 1);
+    if (s[d] == '-') ++d;
+    while (d + 1 < s.size() && s[d] == '0') s.erase(d, 1);
+  }
+  return s;
+}
+
+/// "(0, 1]", "> 0", ">= 0", "< 90", "= 1", or "" when unbounded.
+std::string bounds_text(const KeySpec& s) {
+  const bool lo = std::isfinite(s.min), hi = std::isfinite(s.max);
+  if (lo && hi && s.min == s.max && !s.min_open && !s.max_open) return "= " + fmt_num(s.min);
+  if (lo && hi) {
+    return std::string(s.min_open ? "(" : "[") + fmt_num(s.min) + ", " + fmt_num(s.max) +
+           (s.max_open ? ")" : "]");
+  }
+  if (lo) return std::string(s.min_open ? "> " : ">= ") + fmt_num(s.min);
+  if (hi) return std::string(s.max_open ? "< " : "<= ") + fmt_num(s.max);
+  return "";
+}
+
+bool in_bounds(const KeySpec& s, double x) {
+  if (s.min_open ? !(x > s.min) : !(x >= s.min)) return false;
+  if (s.max_open ? !(x < s.max) : !(x <= s.max)) return false;
+  return true;
+}
+
+/// "must be > 0", "must be in (0, 1]", "must be 1".
+std::string bounds_requirement(const KeySpec& s) {
+  std::string b = bounds_text(s);
+  if (b.compare(0, 2, "= ") == 0) return "must be " + b.substr(2);
+  if (b[0] == '(' || b[0] == '[') return "must be in " + b;
+  return "must be " + b;
+}
+
+// ------------------------------------------------------------------------------------------
+// Document tree: YAML nodes with where they came from
+// ------------------------------------------------------------------------------------------
+
+/// Where a value came from: a file and 1-based line, or "--set k=v" with line 0.
+struct Origin {
+  std::string where;
+  int line = 0;
+};
+
+struct DocEntry;
+
+struct DocNode {
+  enum class Kind { Null, Scalar, List, Map };
+  Kind kind = Kind::Null;
+  std::string text;               ///< Scalar: the text as written
+  bool plain = false;             ///< Scalar: unquoted and untagged (may be a number or boolean)
+  std::vector<DocNode> items;     ///< List
+  std::vector<DocEntry> entries;  ///< Map, in file order
+  Origin origin;
+};
+
+struct DocEntry {
+  std::string key;
+  Origin key_origin;
+  DocNode value;
+};
+
+const DocNode* find_entry(const DocNode& map, const std::string& key) {
+  for (const DocEntry& e : map.entries)
+    if (e.key == key) return &e.value;
+  return nullptr;
+}
+
+[[noreturn]] void fail(const Origin& o, const std::string& key, const std::string& msg) {
+  throw UserError(o.where, o.line, key, msg);
+}
+
+std::string describe(const DocNode& n) {
+  switch (n.kind) {
+    case DocNode::Kind::Null:
+      return "nothing (null)";
+    case DocNode::Kind::Scalar:
+      return n.plain ? "'" + n.text + "'" : "the string \"" + n.text + "\"";
+    case DocNode::Kind::List:
+      return "a list of " + std::to_string(n.items.size()) + " item" +
+             (n.items.size() == 1 ? "" : "s");
+    case DocNode::Kind::Map:
+      return "a mapping";
+  }
+  return "?";
+}
+
+/// Converts a yaml-cpp node. `from_file`: lines come from marks; otherwise line 0.
+/// `fallback_line` is used for nodes without a useful mark (null values).
+DocNode convert(const YAML::Node& n, const std::string& where, bool from_file, int fallback_line,
+                const std::string& path) {
+  DocNode d;
+  const int mark_line = n.Mark().line;
+  d.origin.where = where;
+  d.origin.line = !from_file ? 0 : (mark_line >= 0 && !n.IsNull()) ? mark_line + 1 : fallback_line;
+  switch (n.Type()) {
+    case YAML::NodeType::Undefined:
+    case YAML::NodeType::Null:
+      d.kind = DocNode::Kind::Null;
+      break;
+    case YAML::NodeType::Scalar:
+      d.kind = DocNode::Kind::Scalar;
+      d.text = n.Scalar();
+      d.plain = n.Tag() == "?";
+      break;
+    case YAML::NodeType::Sequence: {
+      d.kind = DocNode::Kind::List;
+      std::size_t i = 0;
+      for (const YAML::Node& item : n) {
+        d.items.push_back(
+            convert(item, where, from_file, d.origin.line, path + "[" + std::to_string(i) + "]"));
+        ++i;
+      }
+      break;
+    }
+    case YAML::NodeType::Map:
+      d.kind = DocNode::Kind::Map;
+      for (auto it = n.begin(); it != n.end(); ++it) {
+        Origin ko{where, 0};
+        if (from_file) {
+          const int kl = it->first.Mark().line;
+          ko.line = kl >= 0 ? kl + 1 : d.origin.line;
+        }
+        if (!it->first.IsScalar()) {
+          fail(ko, path,
+               "mapping keys must be plain words, got a " +
+                   std::string(it->first.IsNull() ? "null" : "list or mapping") + " as a key");
+        }
+        const std::string key = it->first.Scalar();
+        const std::string key_path = join_key(path, key);
+        for (const DocEntry& e : d.entries) {
+          if (e.key == key) {
+            fail(ko, key_path,
+                 "duplicate key '" + key + "'" +
+                     (e.key_origin.line > 0
+                          ? " (first at line " + std::to_string(e.key_origin.line) + ")"
+                          : ""));
+          }
+        }
+        d.entries.push_back(
+            DocEntry{key, ko, convert(it->second, where, from_file, ko.line, key_path)});
+      }
+      break;
+  }
+  return d;
+}
+
+/// Parses YAML text into one document; syntax errors are UserErrors at the file and line.
+YAML::Node load_yaml(const std::string& text, const std::string& where, const std::string& key,
+                     bool from_file) {
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(text);
+  } catch (const YAML::Exception& e) {
+    const int line = from_file && e.mark.line >= 0 ? e.mark.line + 1 : 0;
+    throw UserError(where, line, key, "YAML syntax error: " + e.msg);
+  }
+  if (docs.size() > 1) {
+    throw UserError(where, 0, key,
+                    "holds " + std::to_string(docs.size()) +
+                        " YAML documents ('---' separators); a scene is one document");
+  }
+  return docs.empty() ? YAML::Node() : docs.front();
+}
+
+// ------------------------------------------------------------------------------------------
+// Scalar conversions
+// ------------------------------------------------------------------------------------------
+
+bool is_digit(char c) {
+  return c >= '0' && c <= '9';
+}
+
+/// Decimal integer: [+-]?[0-9]+
+bool int_syntax(const std::string& s) {
+  std::size_t i = (!s.empty() && (s[0] == '+' || s[0] == '-')) ? 1 : 0;
+  if (i == s.size()) return false;
+  for (; i < s.size(); ++i)
+    if (!is_digit(s[i])) return false;
+  return true;
+}
+
+/// Decimal real: [+-]? (digits [. digits?] | . digits) ([eE] [+-]? digits)?
+bool real_syntax(const std::string& s) {
+  std::size_t i = (!s.empty() && (s[0] == '+' || s[0] == '-')) ? 1 : 0;
+  std::size_t digits = 0;
+  while (i < s.size() && is_digit(s[i])) ++i, ++digits;
+  if (i < s.size() && s[i] == '.') {
+    ++i;
+    while (i < s.size() && is_digit(s[i])) ++i, ++digits;
+  }
+  if (digits == 0) return false;
+  if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+    ++i;
+    if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+    std::size_t exp_digits = 0;
+    while (i < s.size() && is_digit(s[i])) ++i, ++exp_digits;
+    if (exp_digits == 0) return false;
+  }
+  return i == s.size();
+}
+
+bool non_finite_word(std::string s) {
+  if (!s.empty() && (s[0] == '+' || s[0] == '-')) s.erase(0, 1);
+  if (!s.empty() && s[0] == '.') s.erase(0, 1);
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s == "inf" || s == "nan" || s == "infinity";
+}
+
+const char* skip_plus(const std::string& s) {
+  return s.c_str() + (s[0] == '+' ? 1 : 0);
+}
+
+double to_number(const DocNode& n, const std::string& key) {
+  if (n.kind != DocNode::Kind::Scalar || !n.plain) {
+    fail(n.origin, key,
+         "expected a number, got " + describe(n) +
+             (n.kind == DocNode::Kind::Scalar ? " (write numbers without quotes)" : ""));
+  }
+  if (non_finite_word(n.text)) fail(n.origin, key, "must be a finite number, got " + n.text);
+  if (!real_syntax(n.text)) fail(n.origin, key, "expected a number, got '" + n.text + "'");
+  double x = 0;
+  const char* first = skip_plus(n.text);
+  const char* last = n.text.c_str() + n.text.size();
+  auto [ptr, ec] = std::from_chars(first, last, x);
+  if (ec == std::errc::result_out_of_range) {
+    fail(n.origin, key, "number " + n.text + " is out of the range of a double");
+  }
+  SHELLMPM_CHECK(ec == std::errc() && ptr == last, "from_chars on '" << n.text << "'");
+  if (!std::isfinite(x)) fail(n.origin, key, "must be a finite number, got " + n.text);
+  return x;
+}
+
+long long to_integer(const DocNode& n, const std::string& key) {
+  if (n.kind != DocNode::Kind::Scalar || !n.plain) {
+    fail(n.origin, key,
+         "expected an integer, got " + describe(n) +
+             (n.kind == DocNode::Kind::Scalar ? " (write numbers without quotes)" : ""));
+  }
+  if (!int_syntax(n.text)) {
+    fail(n.origin, key,
+         "expected an integer, got '" + n.text + "'" +
+             (real_syntax(n.text) ? " (no decimal point or exponent)" : ""));
+  }
+  long long v = 0;
+  const char* first = skip_plus(n.text);
+  const char* last = n.text.c_str() + n.text.size();
+  auto [ptr, ec] = std::from_chars(first, last, v);
+  if (ec == std::errc::result_out_of_range) {
+    fail(n.origin, key, "integer " + n.text + " is too large");
+  }
+  SHELLMPM_CHECK(ec == std::errc() && ptr == last, "from_chars on '" << n.text << "'");
+  return v;
+}
+
+std::string to_string_value(const DocNode& n, const std::string& key) {
+  if (n.kind != DocNode::Kind::Scalar) fail(n.origin, key, "expected a string, got " + describe(n));
+  return n.text;
+}
+
+// ------------------------------------------------------------------------------------------
+// MapReader: one mapping read against the schema keys under one prefix
+// ------------------------------------------------------------------------------------------
+
+class MapReader {
+ public:
+  /// @param prefix schema prefix of the keys ("shot", "materials[]", "shape"; "" = top level)
+  /// @param path   instance path for messages ("materials[2]"; "" = top level)
+  /// @param defer_key_check the caller reads `type` first, then calls check_keys(&type)
+  MapReader(const DocNode& node, std::string prefix, std::string path, bool defer_key_check)
+      : node_(node), prefix_(std::move(prefix)), path_(std::move(path)) {
+    if (node_.kind != DocNode::Kind::Map) {
+      fail(node_.origin, path_,
+           "expected a mapping (key: value lines or {...}), got " + describe(node_));
+    }
+    consumed_.assign(node_.entries.size(), false);
+    if (!defer_key_check) check_keys(nullptr);
+  }
+
+  /// Rejects keys the schema does not know here, and keys not allowed for `variant` (the
+  /// block's type) when given.
+  void check_keys(const std::string* variant) const {
+    for (const DocEntry& e : node_.entries) {
+      const KeySpec* s = find_spec(join_key(prefix_, e.key));
+      const std::string where_text = path_.empty() ? "the top level" : path_;
+      if (!s) {
+        fail(e.key_origin, path_of(e.key),
+             "unknown key '" + e.key + "' in " + where_text + " (known" +
+                 (variant ? " for type " + *variant : std::string()) + ": " +
+                 known_keys(prefix_, variant) + ")");
+      }
+      if (variant && !s->only_for.empty() &&
+          std::find(s->only_for.begin(), s->only_for.end(), *variant) == s->only_for.end()) {
+        fail(e.key_origin, path_of(e.key),
+             "'" + e.key + "' is not allowed for type " + *variant + " (only for " +
+                 join(s->only_for) + "; keys for " + *variant + ": " +
+                 known_keys(prefix_, variant) + ")");
+      }
+    }
+  }
+
+  bool has(const std::string& key) const { return index_of(key) >= 0; }
+  std::string path_of(const std::string& key) const { return join_key(path_, key); }
+  const Origin& origin() const { return node_.origin; }
+  /// Origin of the key's value, or of this mapping when the key is absent.
+  const Origin& origin_of(const std::string& key) const {
+    const int i = index_of(key);
+    return i >= 0 ? node_.entries[i].value.origin : node_.origin;
+  }
+  /// Origin of the key itself (for "not both" errors), or of this mapping.
+  const Origin& key_origin_of(const std::string& key) const {
+    const int i = index_of(key);
+    return i >= 0 ? node_.entries[i].key_origin : node_.origin;
+  }
+
+  long long integer(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Int);
+    const DocNode& v = value(key, s);
+    const long long x = to_integer(v, path_of(key));
+    if (!in_bounds(s, static_cast<double>(x))) {
+      fail(v.origin, path_of(key), bounds_requirement(s) + ", got " + v.text);
+    }
+    return x;
+  }
+
+  int int32(const std::string& key) {
+    const long long x = integer(key);
+    if (x > INT_MAX || x < INT_MIN) {
+      fail(origin_of(key), path_of(key), "integer " + std::to_string(x) + " is too large");
+    }
+    return static_cast<int>(x);
+  }
+
+  double number(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Number);
+    const DocNode& v = value(key, s);
+    const double x = to_number(v, path_of(key));
+    if (!in_bounds(s, x)) fail(v.origin, path_of(key), bounds_requirement(s) + ", got " + v.text);
+    return x;
+  }
+
+  bool boolean(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Bool);
+    const DocNode& v = value(key, s);
+    if (v.kind == DocNode::Kind::Scalar && v.plain && v.text == "true") return true;
+    if (v.kind == DocNode::Kind::Scalar && v.plain && v.text == "false") return false;
+    fail(v.origin, path_of(key), "expected true or false, got " + describe(v));
+  }
+
+  std::string string(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::String);
+    const DocNode& v = value(key, s);
+    std::string x = to_string_value(v, path_of(key));
+    if (s.nonempty && x.empty()) fail(v.origin, path_of(key), "must not be empty");
+    return x;
+  }
+
+  std::string choice(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Enum);
+    const DocNode& v = value(key, s);
+    if (v.kind != DocNode::Kind::Scalar) {
+      fail(v.origin, path_of(key), "expected one of " + join(s.choices) + ", got " + describe(v));
+    }
+    if (std::find(s.choices.begin(), s.choices.end(), v.text) == s.choices.end()) {
+      fail(v.origin, path_of(key), "expected one of " + join(s.choices) + ", got '" + v.text + "'");
+    }
+    return v.text;
+  }
+
+  Vec3d vec3(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Vec3);
+    const DocNode& v = value(key, s);
+    if (v.kind != DocNode::Kind::List || v.items.size() != 3) {
+      fail(v.origin, path_of(key), "expected a list of 3 numbers [x, y, z], got " + describe(v));
+    }
+    Vec3d x;
+    for (int i = 0; i < 3; ++i) {
+      x[i] = to_number(v.items[i], path_of(key) + "[" + std::to_string(i) + "]");
+    }
+    if (s.unit_vector) {
+      const double len = x.norm();
+      if (!(len > 0.0) || !std::isfinite(len)) {
+        fail(v.origin, path_of(key), "must be a nonzero vector, got [0, 0, 0]");
+      }
+      x /= len;
+    }
+    return x;
+  }
+
+  std::pair<int, int> frames(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::FrameRange);
+    const DocNode& v = value(key, s);
+    if (v.kind != DocNode::Kind::List || v.items.size() != 2) {
+      fail(v.origin, path_of(key), "expected [first, last] frames, got " + describe(v));
+    }
+    int f[2];
+    for (int i = 0; i < 2; ++i) {
+      const std::string item_key = path_of(key) + "[" + std::to_string(i) + "]";
+      const long long x = to_integer(v.items[i], item_key);
+      if (!in_bounds(s, static_cast<double>(x)) || x > INT_MAX) {
+        fail(v.items[i].origin, item_key,
+             (x > INT_MAX ? std::string("is too large") : bounds_requirement(s)) + ", got " +
+                 v.items[i].text);
+      }
+      f[i] = static_cast<int>(x);
+    }
+    if (f[1] < f[0]) {
+      fail(v.origin, path_of(key),
+           "last frame " + std::to_string(f[1]) + " is before first frame " + std::to_string(f[0]));
+    }
+    return {f[0], f[1]};
+  }
+
+  /// A Map, List or Shape value: the given one, the default, or nullptr when an Optional key
+  /// is absent. Checks the node kind.
+  const DocNode* block(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Map, KeyType::List, KeyType::Shape);
+    if (s.presence == Presence::Optional && !has(key)) return nullptr;
+    const DocNode& v = value(key, s);
+    const bool want_list = s.type == KeyType::List;
+    const DocNode::Kind want = want_list ? DocNode::Kind::List : DocNode::Kind::Map;
+    if (v.kind != want) {
+      fail(v.origin, path_of(key),
+           std::string(want_list ? "expected a list (write [] for none), got "
+                                 : "expected a mapping (key: value lines or {...}), got ") +
+               describe(v));
+    }
+    return &v;
+  }
+
+  /// Internal check: every key present was read by the code (the schema has no dead keys).
+  void finish() const {
+    for (std::size_t i = 0; i < node_.entries.size(); ++i) {
+      SHELLMPM_CHECK(consumed_[i], "scene key " << path_of(node_.entries[i].key)
+                                                << " is in the schema but was never read");
+    }
+  }
+
+ private:
+  int index_of(const std::string& key) const {
+    for (std::size_t i = 0; i < node_.entries.size(); ++i)
+      if (node_.entries[i].key == key) return static_cast<int>(i);
+    return -1;
+  }
+
+  const KeySpec& spec(const std::string& key, KeyType t1, KeyType t2 = KeyType::Int,
+                      KeyType t3 = KeyType::Int) const {
+    const KeySpec* s = find_spec(join_key(prefix_, key));
+    SHELLMPM_CHECK(s != nullptr, "no schema entry for " << join_key(prefix_, key));
+    SHELLMPM_CHECK(s->type == t1 || s->type == t2 || s->type == t3,
+                   "schema type of " << s->key << " does not match the reader");
+    return *s;
+  }
+
+  /// The present value (marked read), or the schema default, or a missing-key error.
+  const DocNode& value(const std::string& key, const KeySpec& s) {
+    const int i = index_of(key);
+    if (i >= 0) {
+      consumed_[i] = true;
+      return node_.entries[i].value;
+    }
+    if (s.presence == Presence::Required) {
+      std::string hint;
+      if (s.type == KeyType::Enum) hint = " (one of " + join(s.choices) + ")";
+      fail(node_.origin, path_of(key), "required key '" + key + "' is missing" + hint);
+    }
+    SHELLMPM_CHECK(s.presence == Presence::Default,
+                   "optional key " << s.key << " read without a has() check");
+    // A default is validated exactly like user input; it is reported at this mapping.
+    defaults_.push_back(convert(load_yaml(s.default_value, "default of " + s.key, s.key, false),
+                                node_.origin.where, false, 0, s.key));
+    set_origin(defaults_.back(), node_.origin);
+    return defaults_.back();
+  }
+
+  static void set_origin(DocNode& n, const Origin& o) {
+    n.origin = o;
+    for (DocNode& c : n.items) set_origin(c, o);
+    for (DocEntry& e : n.entries) {
+      e.key_origin = o;
+      set_origin(e.value, o);
+    }
+  }
+
+  const DocNode& node_;
+  std::string prefix_;
+  std::string path_;
+  std::vector<bool> consumed_;
+  std::deque<DocNode> defaults_;  // stable addresses for returned defaults
+};
+
+// ------------------------------------------------------------------------------------------
+// Overrides: "a.b[0].c=value" set into the document before validation
+// ------------------------------------------------------------------------------------------
+
+struct PathSeg {
+  std::string name;  ///< key name, or empty for an index
+  std::size_t index = 0;
+  bool is_index = false;
+};
+
+std::vector<PathSeg> split_override_path(const std::string& key, const std::string& where) {
+  std::vector<PathSeg> segs;
+  std::size_t i = 0;
+  auto bad = [&](const std::string& why) {
+    throw UserError(where, 0, "", "bad key path '" + key + "': " + why);
+  };
+  auto parse_index = [&](const std::string& digits) {
+    std::size_t v = 0;
+    auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+    if (ec != std::errc() || ptr != digits.data() + digits.size()) bad("bad index " + digits);
+    return v;
+  };
+  while (true) {
+    std::size_t j = i;
+    while (j < key.size() && key[j] != '.' && key[j] != '[') ++j;
+    const std::string name = key.substr(i, j - i);
+    if (name.empty()) bad("empty key name");
+    const bool digits = std::all_of(name.begin(), name.end(), is_digit);
+    segs.push_back(digits ? PathSeg{"", parse_index(name), true} : PathSeg{name, 0, false});
+    while (j < key.size() && key[j] == '[') {
+      const std::size_t close = key.find(']', j);
+      if (close == std::string::npos) bad("missing ']'");
+      const std::string idx = key.substr(j + 1, close - j - 1);
+      if (idx.empty() || !std::all_of(idx.begin(), idx.end(), is_digit)) {
+        bad("list index must be a number, got [" + idx + "]");
+      }
+      segs.push_back(PathSeg{"", parse_index(idx), true});
+      j = close + 1;
+    }
+    if (j == key.size()) break;
+    if (key[j] != '.') bad("expected '.' or '[' after ']'");
+    i = j + 1;
+  }
+  return segs;
+}
+
+void apply_override(DocNode& root, const std::string& ov) {
+  const std::string where = "--set " + ov;
+  const std::size_t eq = ov.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw UserError(where, 0, "", "expected KEY=VALUE, e.g. shot.dx=0.01");
+  }
+  const std::string key = ov.substr(0, eq);
+  const std::string text = ov.substr(eq + 1);
+  const std::vector<PathSeg> segs = split_override_path(key, where);
+  const Origin origin{where, 0};
+
+  // State while walking: the node, what the schema says it is, and its schema prefix.
+  enum class Expect { Map, List, Leaf };
+  DocNode* cur = &root;
+  Expect expect = Expect::Map;
+  std::string prefix;  // Map: prefix of its keys; List: prefix of its items' keys
+  std::string path;    // instance path so far
+  for (std::size_t si = 0; si < segs.size(); ++si) {
+    const PathSeg& seg = segs[si];
+    const bool last = si + 1 == segs.size();
+    const std::string shown = path.empty() ? "the top level" : path;
+    if (seg.is_index) {
+      const std::string item_path = path + "[" + std::to_string(seg.index) + "]";
+      if (expect != Expect::List) {
+        throw UserError(where, 0, item_path, shown + " is not a list");
+      }
+      if (cur->kind != DocNode::Kind::List) {
+        throw UserError(where, 0, item_path,
+                        path + " is " + describe(*cur) + " in the scene, not a list");
+      }
+      if (seg.index >= cur->items.size()) {
+        throw UserError(where, 0, item_path,
+                        "index " + std::to_string(seg.index) + " is out of range: " + path +
+                            " has " + std::to_string(cur->items.size()) + " entr" +
+                            (cur->items.size() == 1 ? "y" : "ies"));
+      }
+      cur = &cur->items[seg.index];
+      path = item_path;
+      expect = Expect::Map;  // every list in the format is a list of mappings
+      if (last) break;
+      continue;
+    }
+    const std::string key_path = join_key(path, seg.name);
+    if (expect == Expect::List) {
+      throw UserError(where, 0, key_path,
+                      path + " is a list; select an entry by index, e.g. " + path + "[0]." +
+                          seg.name + " or " + path + ".0." + seg.name);
+    }
+    const KeySpec* s = expect == Expect::Map ? find_spec(join_key(prefix, seg.name)) : nullptr;
+    if (!s) {
+      throw UserError(where, 0, key_path,
+                      "unknown key '" + seg.name + "' in " + shown + " (known: " +
+                          (expect == Expect::Map ? known_keys(prefix, nullptr)
+                                                 : "none; " + path + " has no sub-keys") +
+                          ")");
+    }
+    if (cur->kind != DocNode::Kind::Map) {
+      throw UserError(where, 0, key_path,
+                      shown + " is " + describe(*cur) + " in the scene, not a mapping");
+    }
+    DocEntry* entry = nullptr;
+    for (DocEntry& e : cur->entries)
+      if (e.key == seg.name) entry = &e;
+    if (!entry) {
+      DocNode fresh;
+      fresh.origin = origin;
+      fresh.kind = s->type == KeyType::List ? DocNode::Kind::List : DocNode::Kind::Map;
+      cur->entries.push_back(DocEntry{seg.name, origin, fresh});
+      entry = &cur->entries.back();
+    }
+    cur = &entry->value;
+    path = key_path;
+    prefix = child_prefix(*s);
+    expect = s->type == KeyType::List                                 ? Expect::List
+             : (s->type == KeyType::Map || s->type == KeyType::Shape) ? Expect::Map
+                                                                      : Expect::Leaf;
+  }
+  *cur = convert(load_yaml(text, where, path, false), where, false, 0, path);
+}
+
+// ------------------------------------------------------------------------------------------
+// Building the Scene
+// ------------------------------------------------------------------------------------------
+
+constexpr const char* kAxis[3] = {"x", "y", "z"};
+
+void require_greater(const Vec3d& lo, const Vec3d& hi, const Origin& o, const std::string& key) {
+  for (int a = 0; a < 3; ++a) {
+    if (!(hi[a] > lo[a])) {
+      fail(o, key,
+           std::string("must be greater than min on every axis, but on ") + kAxis[a] +
+               " max = " + fmt_num(hi[a]) + " <= min = " + fmt_num(lo[a]));
+    }
+  }
+}
+
+void require_one_hash_run(const std::string& pattern, const Origin& o, const std::string& key) {
+  int runs = 0;
+  for (std::size_t i = 0; i < pattern.size(); ++i)
+    if (pattern[i] == '#' && (i == 0 || pattern[i - 1] != '#')) ++runs;
+  if (runs != 1) {
+    fail(o, key,
+         "must contain exactly one run of '#' (replaced by the zero-padded frame number), got '" +
+             pattern + "'");
+  }
+}
+
+void read_shot(const DocNode& node, ShotSettings& shot) {
+  MapReader r(node, "shot", "shot", false);
+  std::tie(shot.frame_start, shot.frame_end) = r.frames("frames");
+  shot.fps = r.number("fps");
+  shot.cfl = r.number("cfl");
+  shot.dt_min = r.number("dt_min");
+  shot.dt_max = r.number("dt_max");
+  if (shot.dt_max < shot.dt_min) {
+    const std::string at = r.has("dt_max") ? "dt_max" : "dt_min";
+    fail(r.origin_of(at), r.path_of(at),
+         "dt_max (" + fmt_num(shot.dt_max) + ") must be >= dt_min (" + fmt_num(shot.dt_min) + ")");
+  }
+  shot.gravity = r.vec3("gravity");
+  {
+    MapReader d(*r.block("domain"), "shot.domain", "shot.domain", false);
+    shot.domain_min = d.vec3("min");
+    shot.domain_max = d.vec3("max");
+    require_greater(shot.domain_min, shot.domain_max, d.origin_of("max"), d.path_of("max"));
+    d.finish();
+  }
+  shot.dx = r.number("dx");
+  constexpr double kMaxCells = 1 << 20;
+  for (int a = 0; a < 3; ++a) {
+    const double cells = (shot.domain_max[a] - shot.domain_min[a]) / shot.dx;
+    if (cells > kMaxCells) {
+      fail(r.origin_of("dx"), r.path_of("dx"),
+           "the domain is " + fmt_num(std::ceil(cells)) + " cells along " + kAxis[a] +
+               " (at most 2^20 = 1048576); use a larger dx or a smaller domain");
+    }
+  }
+  shot.threads = r.int32("threads");
+  shot.transfer = r.choice("transfer");
+  shot.units = r.string("units");
+  r.finish();
+}
+
+MaterialDesc read_material(const DocNode& node, const std::string& path) {
+  MapReader r(node, "materials[]", path, true);
+  MaterialDesc m;
+  m.name = r.string("name");
+  const std::string type = r.choice("type");
+  r.check_keys(&type);
+  m.kind = type == "elastic" ? MaterialKind::Elastic
+           : type == "sand"  ? MaterialKind::Sand
+                             : MaterialKind::Snow;
+  if (m.kind == MaterialKind::Elastic) {
+    m.model = r.choice("model") == "neo_hookean" ? ElasticModel::NeoHookean
+                                                 : ElasticModel::FixedCorotated;
+  }
+  m.youngs_modulus = r.number("youngs_modulus");
+  m.poisson_ratio = r.number("poisson_ratio");
+  m.density = r.number("density");
+  if (m.kind == MaterialKind::Sand) {
+    m.friction_angle_deg = r.number("friction_angle");
+    m.cohesion = r.number("cohesion");
+  }
+  if (m.kind == MaterialKind::Snow) {
+    m.critical_compression = r.number("critical_compression");
+    m.critical_stretch = r.number("critical_stretch");
+    m.hardening = r.number("hardening");
+  }
+  r.finish();
+  return m;
+}
+
+ShapeDesc read_shape(const DocNode& node, const std::string& path, bool for_source,
+                     const std::string& scene_path) {
+  MapReader r(node, "shape", path, true);
+  const std::string type = r.choice("type");
+  if (for_source && type == "plane") {
+    fail(r.origin_of("type"), r.path_of("type"),
+         "a plane cannot be a source (use box, sphere, cylinder or mesh)");
+  }
+  r.check_keys(&type);
+  ShapeDesc s;
+  if (type == "box") {
+    s.kind = ShapeDesc::Kind::Box;
+    s.min = r.vec3("min");
+    s.max = r.vec3("max");
+    require_greater(s.min, s.max, r.origin_of("max"), r.path_of("max"));
+  } else if (type == "sphere") {
+    s.kind = ShapeDesc::Kind::Sphere;
+    s.center = r.vec3("center");
+    s.radius = r.number("radius");
+  } else if (type == "cylinder") {
+    s.kind = ShapeDesc::Kind::Cylinder;
+    s.center = r.vec3("center");
+    s.axis = r.vec3("axis");
+    s.radius = r.number("radius");
+    s.height = r.number("height");
+  } else if (type == "plane") {
+    s.kind = ShapeDesc::Kind::Plane;
+    s.point = r.vec3("point");
+    s.normal = r.vec3("normal");
+  } else {
+    SHELLMPM_CHECK(type == "mesh", "shape type " << type);
+    s.kind = ShapeDesc::Kind::Mesh;
+    const std::string raw = r.string("path");
+    fs::path p(raw);
+    if (p.is_relative()) p = fs::path(scene_path).parent_path() / p;
+    p = p.lexically_normal();
+    const Origin& o = r.origin_of("path");
+    std::error_code ec;
+    const fs::file_status st = fs::status(p, ec);
+    if (!fs::exists(st)) fail(o, r.path_of("path"), "mesh file not found: " + p.string());
+    if (!fs::is_regular_file(st)) fail(o, r.path_of("path"), "not a regular file: " + p.string());
+    if (!std::ifstream(p, std::ios::binary)) {
+      fail(o, r.path_of("path"),
+           "cannot read mesh file " + p.string() + ": " + std::strerror(errno));
+    }
+    s.mesh_path = p.string();
+    s.mesh_where =
+        (o.line > 0 ? o.where + ":" + std::to_string(o.line) : o.where) + ": " + r.path_of("path");
+    s.mesh_scale = r.number("scale");
+    s.mesh_translate = r.vec3("translate");
+  }
+  r.finish();
+  return s;
+}
+
+Scene build_scene(const DocNode& root, const std::string& path) {
+  Scene scene;
+  scene.path = path;
+  MapReader top(root, "", "", true);
+  top.integer("version");  // first, so a file from another version fails on that alone
+  top.check_keys(nullptr);
+  read_shot(*top.block("shot"), scene.shot);
+
+  // materials
+  std::map<std::string, std::string> material_names;  // name -> path of its first use
+  const DocNode& materials = *top.block("materials");
+  for (std::size_t i = 0; i < materials.items.size(); ++i) {
+    const std::string p = "materials[" + std::to_string(i) + "]";
+    MaterialDesc m = read_material(materials.items[i], p);
+    if (!material_names.emplace(m.name, p).second) {
+      const DocNode* name_node = find_entry(materials.items[i], "name");
+      SHELLMPM_CHECK(name_node != nullptr, "no name in " << p);
+      fail(name_node->origin, p + ".name",
+           "duplicate material name '" + m.name + "' (also " + material_names[m.name] + ")");
+    }
+    scene.materials.push_back(std::move(m));
+  }
+
+  // sources
+  std::map<std::string, std::string> source_names;  // name -> path of its first use
+  const DocNode& sources = *top.block("sources");
+  for (std::size_t i = 0; i < sources.items.size(); ++i) {
+    const std::string p = "sources[" + std::to_string(i) + "]";
+    MapReader r(sources.items[i], "sources[]", p, false);
+    SourceDesc src;
+    src.name = r.has("name") ? r.string("name") : "source" + std::to_string(i);
+    if (!source_names.emplace(src.name, p).second) {
+      fail(r.origin_of("name"), r.path_of("name"),
+           "duplicate source name '" + src.name + "' (also " + source_names[src.name] + ")");
+    }
+    const std::string mat = r.string("material");
+    auto found = std::find_if(scene.materials.begin(), scene.materials.end(),
+                              [&](const MaterialDesc& m) { return m.name == mat; });
+    if (found == scene.materials.end()) {
+      std::vector<std::string> names;
+      for (const MaterialDesc& m : scene.materials) names.push_back(m.name);
+      fail(r.origin_of("material"), r.path_of("material"),
+           "unknown material '" + mat + "' (" +
+               (names.empty() ? std::string("no materials are defined")
+                              : "materials: " + join(names)) +
+               ")");
+    }
+    src.material = static_cast<int>(found - scene.materials.begin());
+    src.shape = read_shape(*r.block("shape"), r.path_of("shape"), true, path);
+    src.particles_per_cell = r.number("particles_per_cell");
+    src.velocity = r.vec3("velocity");
+    src.seed = static_cast<unsigned>(r.integer("seed"));
+    if (const DocNode* emit = r.block("emit")) {
+      MapReader e(*emit, "sources[].emit", r.path_of("emit"), false);
+      std::tie(src.emit_start, src.emit_end) = e.frames("frames");
+      e.finish();
+      src.emit = true;
+      if (src.velocity.isZero(0.0)) {
+        fail(emit->origin, r.path_of("emit"),
+             "continuous emission needs a nonzero velocity (" + r.path_of("velocity") +
+                 " is [0, 0, 0])");
+      }
+    }
+    r.finish();
+    scene.sources.push_back(std::move(src));
+  }
+
+  // colliders
+  std::map<std::string, std::string> collider_names;
+  const DocNode& colliders = *top.block("colliders");
+  for (std::size_t i = 0; i < colliders.items.size(); ++i) {
+    const std::string p = "colliders[" + std::to_string(i) + "]";
+    MapReader r(colliders.items[i], "colliders[]", p, false);
+    ColliderDesc c;
+    c.name = r.has("name") ? r.string("name") : "collider" + std::to_string(i);
+    if (!collider_names.emplace(c.name, p).second) {
+      fail(r.origin_of("name"), r.path_of("name"),
+           "duplicate collider name '" + c.name + "' (also " + collider_names[c.name] + ")");
+    }
+    c.shape = read_shape(*r.block("shape"), r.path_of("shape"), false, path);
+    const std::string boundary = r.choice("boundary");
+    c.boundary = boundary == "sticky" ? BoundaryKind::Sticky
+                 : boundary == "slip" ? BoundaryKind::Slip
+                                      : BoundaryKind::Separate;
+    c.friction = r.number("friction");
+    const DocNode& keys = *r.block("keyframes");
+    for (std::size_t k = 0; k < keys.items.size(); ++k) {
+      const std::string kp = r.path_of("keyframes") + "[" + std::to_string(k) + "]";
+      MapReader kr(keys.items[k], "colliders[].keyframes[]", kp, false);
+      Keyframe kf;
+      const bool has_time = kr.has("time"), has_frame = kr.has("frame");
+      if (has_time && has_frame) {
+        fail(kr.key_origin_of("frame"), kp, "give either time or frame, not both");
+      }
+      if (!has_time && !has_frame) fail(kr.origin(), kp, "needs a time (seconds) or a frame");
+      // Frame N is the state written as frame N, at t = (N - 1) / fps (frame 1 = start).
+      kf.time = has_time ? kr.number("time") : (kr.int32("frame") - 1) / scene.shot.fps;
+      const std::string tkey = has_time ? "time" : "frame";
+      if (!c.keyframes.empty() && !(kf.time > c.keyframes.back().time)) {
+        fail(kr.origin_of(tkey), kr.path_of(tkey),
+             "keyframe times must strictly increase: " + fmt_num(kf.time) + " s is not after " +
+                 fmt_num(c.keyframes.back().time) + " s (keyframe " + std::to_string(k - 1) + ")");
+      }
+      kf.translate = kr.vec3("translate");
+      kf.rotate_deg = kr.vec3("rotate");
+      kr.finish();
+      c.keyframes.push_back(kf);
+    }
+    r.finish();
+    scene.colliders.push_back(std::move(c));
+  }
+
+  // output
+  {
+    MapReader r(*top.block("output"), "output", "output", false);
+    OutputSettings& o = scene.output;
+    o.directory = r.string("directory");
+    o.density = r.boolean("density");
+    o.density_pattern = r.string("density_pattern");
+    require_one_hash_run(o.density_pattern, r.origin_of("density_pattern"),
+                         r.path_of("density_pattern"));
+    o.velocity = r.boolean("velocity");
+    o.half_float = r.boolean("half_float");
+    o.voxel_size = r.number("voxel_size");
+    o.particles = r.boolean("particles");
+    o.particles_pattern = r.string("particles_pattern");
+    require_one_hash_run(o.particles_pattern, r.origin_of("particles_pattern"),
+                         r.path_of("particles_pattern"));
+    o.stats_file = r.string("stats");
+    o.checkpoint_every = r.int32("checkpoint_every");
+    r.finish();
+  }
+  top.finish();
+  return scene;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+// Public
+// ------------------------------------------------------------------------------------------
+
+std::string KeySpec::type_text() const {
+  switch (type) {
+    case KeyType::Int:
+      return "integer";
+    case KeyType::Number:
+      return "number";
+    case KeyType::Bool:
+      return "boolean";
+    case KeyType::String:
+      return "string";
+    case KeyType::Enum:
+      return "enum";
+    case KeyType::Vec3:
+      return "vec3";
+    case KeyType::FrameRange:
+      return "frame range";
+    case KeyType::Map:
+      return "mapping";
+    case KeyType::List:
+      return "list";
+    case KeyType::Shape:
+      return "shape";
+  }
+  return "?";
+}
+
+std::string KeySpec::unit_text() const {
+  return unit.empty() ? "-" : unit;
+}
+
+std::string KeySpec::default_text() const {
+  switch (presence) {
+    case Presence::Required:
+      return "required";
+    case Presence::Default:
+      return "`" + default_value + "`";
+    case Presence::Optional:
+      return default_value;
+  }
+  return "?";
+}
+
+std::string KeySpec::range_text() const {
+  std::vector<std::string> parts;
+  if (type == KeyType::FrameRange) {
+    parts.push_back("first " + bounds_text(*this) + ", last >= first");
+  } else if (!bounds_text(*this).empty()) {
+    parts.push_back(bounds_text(*this));
+  }
+  if (!choices.empty()) parts.push_back("one of: " + join(choices));
+  if (nonempty) parts.push_back("non-empty");
+  if (unit_vector) parts.push_back("nonzero; normalized");
+  if (!rule.empty()) parts.push_back(rule);
+  return parts.empty() ? "-" : join(parts, "; ");
+}
+
+std::string KeySpec::only_for_text() const {
+  return only_for.empty() ? "-" : join(only_for);
+}
+
+const std::vector<KeySpec>& scene_schema() {
+  static const std::vector<KeySpec> schema = build_schema();
+  return schema;
+}
+
+Scene parse_scene(const std::string& text, const std::string& path,
+                  const std::vector<std::string>& overrides) {
+  DocNode root = convert(load_yaml(text, path, "", true), path, true, 0, "");
+  if (root.kind == DocNode::Kind::Null) {
+    throw UserError(path, 0, "", "the scene is empty; it needs at least 'version: 1' and 'shot'");
+  }
+  if (root.kind != DocNode::Kind::Map) {
+    fail(root.origin, "", "expected a mapping of keys at the top level, got " + describe(root));
+  }
+  for (const std::string& ov : overrides) apply_override(root, ov);
+  return build_scene(root, path);
+}
+
+Scene read_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw UserError(path, 0, "", "is a directory, not a scene file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw UserError(path, 0, "", std::string("cannot open scene file: ") + std::strerror(errno));
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw UserError(path, 0, "", "cannot read scene file");
+  return parse_scene(text.str(), path, overrides);
+}
+
+}  // namespace shellmpm

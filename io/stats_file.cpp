@@ -1,0 +1,39 @@
+#include "io/stats_file.h"
+
+#include "io/atomic_file.h"
+
+namespace shellmpm {
+
+nlohmann::json frame_stats_json(const FrameStats& s) {
+  nlohmann::json j;
+  j["frame"] = s.frame;
+  j["time"] = s.time;
+  j["substeps"] = s.substeps;
+  j["dt_min"] = s.dt_min;
+  j["dt_max"] = s.dt_max;
+  j["particles"] = s.particles;
+  j["grid_blocks"] = s.grid_blocks;
+  j["mass"] = s.mass;
+  j["kinetic_energy"] = s.kinetic_energy;
+  j["elastic_energy"] = s.elastic_energy;
+  j["momentum"] = {s.momentum.x(), s.momentum.y(), s.momentum.z()};
+  j["max_speed"] = s.max_speed;
+  nlohmann::json wall = nlohmann::json::object();
+  for (const auto& [name, sec] : s.stage_seconds) wall[name] = sec;
+  wall["total"] = s.wall_seconds;
+  j["wall"] = wall;
+  return j;
+}
+
+StatsFile::StatsFile(std::string path, nlohmann::json header)
+    : path_(std::move(path)), header_(std::move(header)) {}
+
+void StatsFile::add(const FrameStats& s) { frames_.push_back(frame_stats_json(s)); }
+
+void StatsFile::write() const {
+  nlohmann::json j = header_;
+  j["frames"] = frames_;
+  write_text_atomic(path_, j.dump(1) + "\n");
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,64 @@
+// The one wrapper every parallel loop goes through (house style 8).
+// Work is split into fixed chunks of `grain` items; how TBB schedules the chunks
+// never changes what a loop computes, so results do not depend on the thread count.
+#pragma once
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <memory>
+
+namespace shellmpm {
+
+/// Runs body(begin, end) over [0, n) in chunks of at most `grain` items.
+/// With `serial` true the chunks run in order on the calling thread.
+template <class Body>
+void parallel_for(std::size_t n, std::size_t grain, Body&& body, bool serial = false) {
+  if (n == 0) return;
+  grain = std::max<std::size_t>(grain, 1);
+  if (serial || n <= grain) {
+    for (std::size_t b = 0; b < n; b += grain) body(b, std::min(n, b + grain));
+    return;
+  }
+  const std::size_t chunks = (n + grain - 1) / grain;
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, chunks, 1),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t c = r.begin(); c != r.end(); ++c)
+          body(c * grain, std::min(n, (c + 1) * grain));
+      },
+      tbb::simple_partitioner());
+}
+
+/// Runs body(i) for each i in [0, n), chunked by `grain`.
+template <class Body>
+void parallel_for_each(std::size_t n, std::size_t grain, Body&& body, bool serial = false) {
+  parallel_for(
+      n, grain,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) body(i);
+      },
+      serial);
+}
+
+/// Limits TBB to `threads` workers for the lifetime of this object (0 = all cores).
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads) {
+    if (threads > 0)
+      control_ = std::make_unique<tbb::global_control>(
+          tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+  }
+  /// The number of threads TBB may use now.
+  static int active() {
+    return static_cast<int>(
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  }
+
+ private:
+  std::unique_ptr<tbb::global_control> control_;
+};
+
+}  // namespace shellmpm

@@ -1,0 +1,45 @@
+// Bulk MPM particles, stored as named attribute arrays (house style 6).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "sim/core/types.h"
+
+namespace shellmpm {
+
+/// Structure of arrays. Mass is volume * rest density of the particle's material.
+struct ParticleSet {
+  std::vector<Vec3> x;                  ///< position [m]
+  std::vector<Vec3> v;                  ///< velocity [m/s]
+  std::vector<Mat3> C;                  ///< APIC affine velocity matrix [1/s]
+  std::vector<Mat3> F;                  ///< (elastic) deformation gradient
+  std::vector<Real> volume;             ///< rest volume V0 [m^3]
+  std::vector<std::uint16_t> material;  ///< index into the solver's material table
+  std::vector<std::uint32_t> id;        ///< stable id, in order of creation
+  std::vector<Real> plastic;            ///< plastic scalar; empty when no material needs it
+
+  std::size_t size() const { return x.size(); }
+  bool has_plastic() const { return keep_plastic; }
+  bool keep_plastic = false;  ///< allocate `plastic` (set when any material is plastic)
+
+  /// Appends one particle at rest deformation.
+  void push_back(const Vec3& pos, const Vec3& vel, Real vol, std::uint16_t mat,
+                 Real plastic0) {
+    x.push_back(pos);
+    v.push_back(vel);
+    C.push_back(Mat3::Zero());
+    F.push_back(Mat3::Identity());
+    volume.push_back(vol);
+    material.push_back(mat);
+    id.push_back(next_id++);
+    if (keep_plastic) plastic.push_back(plastic0);
+  }
+  /// Reorders every attribute so that new index i holds old index order[i].
+  void permute(const std::vector<std::uint32_t>& order);
+  /// Bytes held by the particle arrays (capacity), per particle when divided by size().
+  std::size_t bytes() const;
+
+  std::uint32_t next_id = 0;
+};
+
+}  // namespace shellmpm

@@ -1,0 +1,141 @@
+#include "sim/mpm/sparse_grid.h"
+
+#include <cmath>
+#include <cstring>
+
+#include "sim/core/check.h"
+#include "sim/core/parallel.h"
+
+namespace shellmpm {
+
+void SparseGrid::setup(double dx, const Vec3d& origin) {
+  SHELLMPM_CHECK(dx > 0, << dx);
+  dx_ = dx;
+  inv_dx_ = 1.0 / dx;
+  origin_ = origin;
+}
+
+void SparseGrid::bin(const std::vector<Vec3>& x, bool serial) {
+  const std::size_t n = x.size();
+  pblock_of_.resize(n);
+  phash_.clear();
+  pblock_key.clear();
+  // Serial pass in particle order: particle-block indices follow first appearance.
+  std::uint64_t last_key = BlockHash::kEmpty;
+  int last_id = -1;
+  for (std::size_t p = 0; p < n; ++p) {
+    const Vec3 g = grid_coord(x[p]);
+    const int bx = static_cast<int>(std::floor(g[0] - Real(0.5))) >> 2;
+    const int by = static_cast<int>(std::floor(g[1] - Real(0.5))) >> 2;
+    const int bz = static_cast<int>(std::floor(g[2] - Real(0.5))) >> 2;
+    SHELLMPM_CHECK(bx >= 0 && by >= 0 && bz >= 0 && bx < (1 << 19) && by < (1 << 19) &&
+                       bz < (1 << 19),
+                   << "particle " << p << " at " << x[p].transpose() << " is off the grid");
+    const std::uint64_t key = pack_block(bx, by, bz);
+    if (key != last_key) {
+      last_id = phash_.insert(key);
+      if (static_cast<std::size_t>(last_id) == pblock_key.size()) pblock_key.push_back(key);
+      last_key = key;
+    }
+    pblock_of_[p] = static_cast<std::uint32_t>(last_id);
+  }
+  const std::size_t nb = pblock_key.size();
+  // Stable counting sort of particle indices by particle block.
+  pblock_start.assign(nb + 1, 0);
+  for (std::size_t p = 0; p < n; ++p) ++pblock_start[pblock_of_[p] + 1];
+  for (std::size_t b = 0; b < nb; ++b) pblock_start[b + 1] += pblock_start[b];
+  order.resize(n);
+  {
+    std::vector<std::uint32_t> cursor(pblock_start.begin(), pblock_start.end() - 1);
+    for (std::size_t p = 0; p < n; ++p) order[cursor[pblock_of_[p]]++] = static_cast<std::uint32_t>(p);
+  }
+  // Grid blocks: every particle block and its +1 neighbours.
+  ghash_.clear();
+  gblock_key.clear();
+  pblock_nbr.resize(nb);
+  for (std::size_t b = 0; b < nb; ++b) {
+    const Vec3i c = unpack_block(pblock_key[b]);
+    for (int o = 0; o < 8; ++o) {
+      const std::uint64_t k = pack_block(c[0] + (o >> 2), c[1] + ((o >> 1) & 1), c[2] + (o & 1));
+      const int id = ghash_.insert(k);
+      if (static_cast<std::size_t>(id) == gblock_key.size()) gblock_key.push_back(k);
+      pblock_nbr[b][o] = id;
+    }
+  }
+  const std::size_t ng = gblock_key.size();
+  gblock_src.resize(ng);
+  for (std::size_t g = 0; g < ng; ++g) {
+    const Vec3i c = unpack_block(gblock_key[g]);
+    for (int o = 0; o < 8; ++o) {
+      const int sx = c[0] - (o >> 2), sy = c[1] - ((o >> 1) & 1), sz = c[2] - (o & 1);
+      gblock_src[g][o] = (sx < 0 || sy < 0 || sz < 0) ? -1 : phash_.find(pack_block(sx, sy, sz));
+    }
+  }
+  pblock_buf.resize(nb);
+  gblock_nodes.resize(ng);
+  parallel_for(
+      ng, 64,
+      [&](std::size_t b, std::size_t e) {
+        std::memset(static_cast<void*>(gblock_nodes.data() + b), 0,
+                    (e - b) * sizeof(gblock_nodes[0]));
+      },
+      serial);
+}
+
+void SparseGrid::gather_buffers_to_grid(bool serial) {
+  parallel_for(
+      gblock_key.size(), 4,
+      [&](std::size_t gb, std::size_t ge) {
+        for (std::size_t g = gb; g < ge; ++g) {
+          auto& nodes = gblock_nodes[g];
+          for (int o = 0; o < 8; ++o) {
+            const int src = gblock_src[g][o];
+            if (src < 0) continue;
+            const auto& buf = pblock_buf[src];
+            const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
+            const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
+            for (int i = 0; i < ix1; ++i)
+              for (int j = 0; j < iy1; ++j)
+                for (int k = 0; k < iz1; ++k) {
+                  const GridNode& s = buf[pad_node(i + ox, j + oy, k + oz)];
+                  GridNode& d = nodes[block_node(i, j, k)];
+                  d.m += s.m;
+                  d.v[0] += s.v[0];
+                  d.v[1] += s.v[1];
+                  d.v[2] += s.v[2];
+                }
+          }
+        }
+      },
+      serial);
+}
+
+void SparseGrid::scatter_grid_to_buffers(bool serial) {
+  parallel_for(
+      pblock_key.size(), 4,
+      [&](std::size_t bb, std::size_t be) {
+        for (std::size_t b = bb; b < be; ++b) {
+          auto& buf = pblock_buf[b];
+          for (int o = 0; o < 8; ++o) {
+            const auto& nodes = gblock_nodes[pblock_nbr[b][o]];
+            const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
+            const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
+            for (int i = 0; i < ix1; ++i)
+              for (int j = 0; j < iy1; ++j)
+                for (int k = 0; k < iz1; ++k)
+                  buf[pad_node(i + ox, j + oy, k + oz)] = nodes[block_node(i, j, k)];
+          }
+        }
+      },
+      serial);
+}
+
+std::size_t SparseGrid::bytes() const {
+  return order.capacity() * 4 + pblock_start.capacity() * 4 + pblock_key.capacity() * 8 +
+         pblock_nbr.capacity() * 32 + pblock_buf.capacity() * sizeof(pblock_buf[0]) +
+         gblock_key.capacity() * 8 + gblock_src.capacity() * 32 +
+         gblock_nodes.capacity() * sizeof(gblock_nodes[0]) + phash_.bytes() + ghash_.bytes() +
+         pblock_of_.capacity() * 4;
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,82 @@
+// A sparse grid of 4x4x4-node blocks that exist only around particles.
+//
+// Determinism without atomics (house style 7): particles are binned by the block of
+// their lowest stencil node ("particle block"). Each particle block scatters into its
+// own padded 6x6x6 node buffer; each grid block then sums the buffers of the (at most
+// eight) particle blocks that overlap it, always in the same order. No sum depends
+// on how threads are scheduled, so results are bit-identical for any thread count.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "sim/core/types.h"
+#include "sim/mpm/block_hash.h"
+
+namespace shellmpm {
+
+/// One grid node: mass and momentum during P2G, mass and velocity after the update.
+struct GridNode {
+  Real m;
+  Real v[3];
+};
+
+constexpr int kBlockSize = 4;                  ///< nodes per block edge
+constexpr int kBlockNodes = 64;                ///< nodes per block
+constexpr int kPadSize = 6;                    ///< padded particle-block buffer edge
+constexpr int kPadNodes = 216;                 ///< nodes in a padded buffer
+
+/// Node index within a 4^3 block (z fastest).
+inline int block_node(int i, int j, int k) { return (i * kBlockSize + j) * kBlockSize + k; }
+/// Node index within a padded 6^3 buffer (z fastest).
+inline int pad_node(int i, int j, int k) { return (i * kPadSize + j) * kPadSize + k; }
+
+class SparseGrid {
+ public:
+  /// dx: spacing [m]; origin: world position of node (0,0,0) [m].
+  void setup(double dx, const Vec3d& origin);
+
+  /// Bins particle positions into particle blocks, sorts an index list by block and
+  /// allocates (and zeroes) the grid blocks they touch.
+  void bin(const std::vector<Vec3>& x, bool serial = false);
+
+  double dx() const { return dx_; }
+  const Vec3d& origin() const { return origin_; }
+  /// Grid coordinates (position - origin) / dx of a world position.
+  Vec3 grid_coord(const Vec3& p) const {
+    return Vec3(static_cast<Real>((p[0] - origin_[0]) * inv_dx_),
+                static_cast<Real>((p[1] - origin_[1]) * inv_dx_),
+                static_cast<Real>((p[2] - origin_[2]) * inv_dx_));
+  }
+  /// World position of a node.
+  Vec3d node_position(const Vec3i& n) const { return origin_ + dx_ * n.cast<double>(); }
+
+  std::size_t num_particle_blocks() const { return pblock_key.size(); }
+  std::size_t num_grid_blocks() const { return gblock_key.size(); }
+  /// Bytes held by the grid's arrays.
+  std::size_t bytes() const;
+
+  // Particle blocks (binned particles).
+  std::vector<std::uint32_t> order;          ///< particle indices sorted by particle block
+  std::vector<std::uint32_t> pblock_start;   ///< order[pblock_start[b] .. pblock_start[b+1])
+  std::vector<std::uint64_t> pblock_key;     ///< packed block coordinate
+  std::vector<std::array<int, 8>> pblock_nbr;  ///< grid block at key + (ox,oy,oz), o = 4ox+2oy+oz
+  std::vector<std::array<GridNode, kPadNodes>> pblock_buf;  ///< scatter/gather buffers
+  // Grid blocks.
+  std::vector<std::uint64_t> gblock_key;
+  std::vector<std::array<int, 8>> gblock_src;  ///< particle block at key - o, or -1
+  std::vector<std::array<GridNode, kBlockNodes>> gblock_nodes;
+
+  /// Sums every particle block's buffer into the grid blocks (fixed order).
+  void gather_buffers_to_grid(bool serial = false);
+  /// Copies grid node values into each particle block's padded buffer.
+  void scatter_grid_to_buffers(bool serial = false);
+
+ private:
+  double dx_ = 1.0, inv_dx_ = 1.0;
+  Vec3d origin_{0, 0, 0};
+  BlockHash phash_, ghash_;
+  std::vector<std::uint32_t> pblock_of_;  ///< per particle: its particle block
+};
+
+}  // namespace shellmpm

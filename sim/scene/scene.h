@@ -1,0 +1,128 @@
+// The in-memory description of a shot: pure data, filled by io/scene_reader from a
+// scene file (and by tests directly). Units are SI, Y up, unless `units` says otherwise.
+#pragma once
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/core/types.h"
+#include "sim/scene/sdf_grid.h"
+
+namespace shellmpm {
+
+/// Shot-wide settings.
+struct ShotSettings {
+  int frame_start = 1;            ///< first frame written; frame f is the state at t = (f-1)/fps
+  int frame_end = 48;             ///< last frame written, inclusive
+  double fps = 24.0;              ///< frames per second
+  double cfl = 0.3;               ///< CFL number: max particle travel per step, in cells
+  double dt_min = 1e-6;           ///< smallest allowed step [s]; a smaller need is an error
+  double dt_max = 1e-2;           ///< largest allowed step [s]
+  Vec3d gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
+  Vec3d domain_min{-1, -1, -1};   ///< simulation domain; particles are kept inside [m]
+  Vec3d domain_max{1, 1, 1};
+  double dx = 0.02;               ///< grid spacing [m]
+  int threads = 0;                ///< 0 = all cores
+  std::string transfer = "apic";  ///< "apic" (quadratic B-spline APIC) or "mls" (MLS-MPM)
+  std::string units = "m";        ///< informational, written to VDB metadata
+};
+
+enum class MaterialKind { Elastic, Sand, Snow };
+enum class ElasticModel { FixedCorotated, NeoHookean };
+
+/// A bulk MPM material.
+struct MaterialDesc {
+  std::string name;
+  MaterialKind kind = MaterialKind::Elastic;
+  ElasticModel model = ElasticModel::FixedCorotated;  ///< elastic only
+  double youngs_modulus = 1e5;  ///< E [Pa]
+  double poisson_ratio = 0.3;   ///< nu, in [0, 0.5)
+  double density = 1000.0;      ///< rest density [kg/m^3]
+  // sand (Drucker-Prager on Hencky strain, Klar et al. 2016)
+  double friction_angle_deg = 30.0;  ///< internal friction angle [degrees]
+  double cohesion = 0.0;             ///< cohesion, as a Hencky-strain offset (>= 0)
+  // snow (Stomakhin et al. 2013)
+  double critical_compression = 2.5e-2;  ///< theta_c
+  double critical_stretch = 7.5e-3;      ///< theta_s
+  double hardening = 10.0;               ///< xi
+  double max_hardening_jp_min = 0.6;     ///< clamp of Jp from below (keeps hardening finite)
+  double max_hardening_jp_max = 20.0;    ///< clamp of Jp from above
+};
+
+/// A shape used by sources and colliders.
+struct ShapeDesc {
+  enum class Kind { Plane, Box, Sphere, Cylinder, Mesh } kind = Kind::Box;
+  Vec3d min{0, 0, 0}, max{0, 0, 0};  ///< box (local frame)
+  Vec3d center{0, 0, 0};             ///< sphere, cylinder (center of the axis segment)
+  double radius = 0.0;               ///< sphere, cylinder
+  double height = 0.0;               ///< cylinder, along `axis`
+  Vec3d axis{0, 1, 0};               ///< cylinder axis (unit)
+  Vec3d point{0, 0, 0};              ///< plane: a point on it
+  Vec3d normal{0, 1, 0};             ///< plane: outward normal (unit)
+  std::string mesh_path;             ///< mesh: resolved file path
+  /// mesh: where `path` was given, for messages, as "file:line: key" (UserError's prefix),
+  /// e.g. "shot.yaml:14: colliders[0].shape.path"; "--set K=V: key" for an override.
+  std::string mesh_where;
+  double mesh_scale = 1.0;           ///< mesh: uniform scale applied on load
+  Vec3d mesh_translate{0, 0, 0};     ///< mesh: translation applied on load
+  /// mesh: signed distance (negative inside), built by io/ from the mesh file.
+  std::shared_ptr<const SdfGrid> sdf;
+};
+
+/// A particle source.
+struct SourceDesc {
+  std::string name;
+  int material = 0;           ///< index into Scene::materials
+  ShapeDesc shape;
+  double particles_per_cell = 8;
+  Vec3d velocity{0, 0, 0};    ///< initial velocity [m/s]
+  unsigned seed = 1;          ///< jitter seed (sampling is deterministic)
+  bool emit = false;          ///< continuous emission instead of one fill at the start
+  int emit_start = 1;         ///< first frame of emission (inclusive)
+  int emit_end = 1;           ///< last frame of emission (inclusive)
+};
+
+/// One keyframe of a collider's rigid motion (applied about the origin: x' = R s x + T).
+struct Keyframe {
+  double time = 0.0;                   ///< [s]
+  Vec3d translate{0, 0, 0};            ///< [m]
+  Vec3d rotate_deg{0, 0, 0};           ///< XYZ Euler angles [degrees], R = Rz Ry Rx
+};
+
+enum class BoundaryKind { Sticky, Slip, Separate };
+
+/// A collider: a shape, optionally animated, with a boundary condition.
+struct ColliderDesc {
+  std::string name;
+  ShapeDesc shape;
+  BoundaryKind boundary = BoundaryKind::Separate;
+  double friction = 0.0;               ///< Coulomb coefficient (slip, separate)
+  std::vector<Keyframe> keyframes;     ///< empty = static; linear/slerp between keys
+};
+
+/// What to write.
+struct OutputSettings {
+  std::string directory = "out";
+  std::string density_pattern = "density.####.vdb";  ///< '#' run = zero-padded frame
+  std::string particles_pattern = "particles.####.ply";
+  std::string stats_file = "stats.json";
+  bool density = true;          ///< write the density fog volume per frame
+  bool velocity = false;        ///< also write a vec3 `vel` grid
+  bool half_float = false;      ///< store grids as 16-bit floats
+  double voxel_size = 0.0;      ///< 0 = the grid spacing dx
+  bool particles = false;       ///< particle cache (positions, velocities) per frame
+  int checkpoint_every = 0;     ///< frames between checkpoints; 0 = none
+};
+
+/// A whole shot.
+struct Scene {
+  std::string path;  ///< the scene file, for messages
+  ShotSettings shot;
+  std::vector<MaterialDesc> materials;
+  std::vector<SourceDesc> sources;
+  std::vector<ColliderDesc> colliders;
+  OutputSettings output;
+};
+
+}  // namespace shellmpm

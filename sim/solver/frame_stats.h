@@ -1,0 +1,28 @@
+// What one frame of simulation reports (written to the statistics file by io/).
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sim/core/types.h"
+
+namespace shellmpm {
+
+struct FrameStats {
+  int frame = 0;
+  double time = 0;            ///< simulation time at the end of the frame [s]
+  int substeps = 0;
+  double dt_min = 0, dt_max = 0;  ///< range of steps taken [s]
+  std::size_t particles = 0;
+  double kinetic_energy = 0;  ///< sum 1/2 m v^2 [J]
+  double elastic_energy = 0;  ///< sum V0 psi(F) [J]
+  Vec3d momentum{0, 0, 0};    ///< sum m v [kg m/s]
+  double mass = 0;            ///< total particle mass [kg]
+  double max_speed = 0;       ///< [m/s]
+  std::size_t grid_blocks = 0;
+  /// Wall-clock seconds per stage, in stage order (not deterministic, unlike the rest).
+  std::vector<std::pair<std::string, double>> stage_seconds;
+  double wall_seconds = 0;
+};
+
+}  // namespace shellmpm

@@ -1,0 +1,320 @@
+#include "sim/solver/solver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "sim/core/check.h"
+#include "sim/core/parallel.h"
+#include "sim/mpm/transfer.h"
+
+namespace shellmpm {
+namespace {
+
+constexpr int kWallCells = 3;  // nodes this close to the domain boundary act as walls
+constexpr std::size_t kParticleGrain = 4096;
+
+// Sums f(i) over [0, n) in fixed chunks, combining chunk sums in order (deterministic).
+template <class T, class F>
+T ordered_sum(std::size_t n, bool serial, T zero, F f) {
+  const std::size_t chunks = (n + kParticleGrain - 1) / kParticleGrain;
+  std::vector<T> part(chunks, zero);
+  parallel_for(
+      n, kParticleGrain,
+      [&](std::size_t b, std::size_t e) {
+        T acc = zero;
+        for (std::size_t i = b; i < e; ++i) acc += f(i);
+        part[b / kParticleGrain] = acc;
+      },
+      serial);
+  T total = zero;
+  for (const T& p : part) total += p;
+  return total;
+}
+
+}  // namespace
+
+Solver::Solver(const Scene& scene, SolverOptions opt) : scene_(scene), opt_(opt) {
+  const ShotSettings& s = scene_.shot;
+  for (const MaterialDesc& m : scene_.materials) {
+    models_.push_back(ConstitutiveModel::from_desc(m));
+    densities_.push_back(static_cast<Real>(m.density));
+    any_plastic_ = any_plastic_ || models_.back().has_plasticity();
+  }
+  particles_.keep_plastic = any_plastic_;
+  grid_.setup(s.dx, s.domain_min);
+  for (int a = 0; a < 3; ++a)
+    domain_cells_[a] = static_cast<int>(std::floor((s.domain_max[a] - s.domain_min[a]) / s.dx));
+  for (const SourceDesc& src : scene_.sources) {
+    samplers_.emplace_back(src, s.dx, s.fps);
+    any_emit_ = any_emit_ || src.emit;
+  }
+  for (const ColliderDesc& c : scene_.colliders) colliders_.emplace_back(c);
+  if (opt_.fill_sources) {
+    for (std::size_t i = 0; i < samplers_.size(); ++i) {
+      if (scene_.sources[i].emit) continue;
+      std::vector<Vec3d> pts;
+      samplers_[i].fill([&](const Vec3d& p) { pts.push_back(p); });
+      add_particles_from(i, pts);
+    }
+    clamp_to_domain();
+  }
+  build_stages();
+}
+
+void Solver::add_particles_from(std::size_t i, const std::vector<Vec3d>& pts) {
+  const SourceDesc& src = scene_.sources[i];
+  const auto mat = static_cast<std::uint16_t>(src.material);
+  const Real vol = static_cast<Real>(samplers_[i].particle_volume());
+  const Vec3 vel = src.velocity.cast<Real>();
+  const Real pl0 = models_[mat].initial_plastic();
+  for (const Vec3d& p : pts) particles_.push_back(p.cast<Real>(), vel, vol, mat, pl0);
+}
+
+void Solver::build_stages() {
+  stages_.clear();
+  const bool bulk = !scene_.sources.empty();
+  if (!bulk) return;
+  stages_.push_back({"bin", [this] { grid_.bin(particles_.x, opt_.serial); }});
+  stages_.push_back({"p2g", [this] {
+                       TransferParams tp{static_cast<Real>(dt_), scene_.shot.transfer == "mls",
+                                         opt_.serial, true, &models_, &densities_};
+                       particles_to_grid(particles_, grid_, tp);
+                     }});
+  stages_.push_back({"grid", [this] { grid_update(); }});
+  if (!colliders_.empty()) stages_.push_back({"colliders", [this] { apply_colliders(); }});
+  stages_.push_back({"g2p", [this] {
+                       TransferParams tp{static_cast<Real>(dt_), scene_.shot.transfer == "mls",
+                                         opt_.serial, true, &models_, &densities_};
+                       grid_to_particles(particles_, grid_, tp);
+                       clamp_to_domain();
+                     }});
+  if (any_plastic_) stages_.push_back({"plasticity", [this] { project_plasticity(); }});
+  if (any_emit_) stages_.push_back({"emit", [this] { emit(); }});
+}
+
+std::vector<std::string> Solver::stage_names() const {
+  std::vector<std::string> n;
+  for (const Stage& s : stages_) n.push_back(s.name);
+  return n;
+}
+
+void Solver::grid_update() {
+  const Vec3 g = scene_.shot.gravity.cast<Real>();
+  const Real dt = static_cast<Real>(dt_);
+  parallel_for(
+      grid_.num_grid_blocks(), 16,
+      [&](std::size_t bb, std::size_t be) {
+        for (std::size_t b = bb; b < be; ++b) {
+          const Vec3i c = unpack_block(grid_.gblock_key[b]) * kBlockSize;
+          auto& nodes = grid_.gblock_nodes[b];
+          for (int i = 0; i < kBlockSize; ++i)
+            for (int j = 0; j < kBlockSize; ++j)
+              for (int k = 0; k < kBlockSize; ++k) {
+                GridNode& nd = nodes[block_node(i, j, k)];
+                if (nd.m <= 0) continue;
+                const Real inv_m = Real(1) / nd.m;
+                const int n[3] = {c[0] + i, c[1] + j, c[2] + k};
+                for (int a = 0; a < 3; ++a) {
+                  Real v = nd.v[a] * inv_m + dt * g[a];
+                  if (n[a] < kWallCells && v < 0) v = 0;
+                  if (n[a] > domain_cells_[a] - kWallCells && v > 0) v = 0;
+                  nd.v[a] = v;
+                }
+              }
+        }
+      },
+      opt_.serial);
+}
+
+void Solver::apply_colliders() {
+  for (Collider& c : colliders_) c.begin_step(time_, dt_);
+  const double dx = grid_.dx();
+  parallel_for(
+      grid_.num_grid_blocks(), 16,
+      [&](std::size_t bb, std::size_t be) {
+        for (std::size_t b = bb; b < be; ++b) {
+          const Vec3i c = unpack_block(grid_.gblock_key[b]) * kBlockSize;
+          Aabb box;
+          box.lo = grid_.node_position(c).array() - dx;
+          box.hi = grid_.node_position(c + Vec3i::Constant(kBlockSize - 1)).array() + dx;
+          for (const Collider& col : colliders_) {
+            if (!col.bounds().overlaps(box)) continue;
+            auto& nodes = grid_.gblock_nodes[b];
+            for (int i = 0; i < kBlockSize; ++i)
+              for (int j = 0; j < kBlockSize; ++j)
+                for (int k = 0; k < kBlockSize; ++k) {
+                  GridNode& nd = nodes[block_node(i, j, k)];
+                  if (nd.m <= 0) continue;
+                  Vec3 v(nd.v[0], nd.v[1], nd.v[2]);
+                  if (col.apply(grid_.node_position(c + Vec3i(i, j, k)), v)) {
+                    nd.v[0] = v[0];
+                    nd.v[1] = v[1];
+                    nd.v[2] = v[2];
+                  }
+                }
+          }
+        }
+      },
+      opt_.serial);
+}
+
+void Solver::project_plasticity() {
+  parallel_for(
+      particles_.size(), kParticleGrain,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t p = b; p < e; ++p) {
+          const ConstitutiveModel& m = models_[particles_.material[p]];
+          if (m.has_plasticity()) m.project(particles_.F[p], particles_.plastic[p]);
+        }
+      },
+      opt_.serial);
+}
+
+void Solver::emit() {
+  for (std::size_t i = 0; i < samplers_.size(); ++i) {
+    if (!scene_.sources[i].emit) continue;
+    std::vector<Vec3d> pts;
+    samplers_[i].emit(time_, dt_, [&](const Vec3d& p) { pts.push_back(p); });
+    add_particles_from(i, pts);
+  }
+}
+
+void Solver::clamp_to_domain() {
+  const ShotSettings& s = scene_.shot;
+  Vec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = static_cast<Real>(s.domain_min[a] + s.dx);
+    hi[a] = static_cast<Real>(s.domain_min[a] + (domain_cells_[a] - 1) * s.dx);
+  }
+  parallel_for(
+      particles_.size(), kParticleGrain,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t p = b; p < e; ++p) particles_.x[p] = particles_.x[p].cwiseMax(lo).cwiseMin(hi);
+      },
+      opt_.serial);
+}
+
+double Solver::stable_dt() const {
+  const ShotSettings& s = scene_.shot;
+  double dt = s.dt_max;
+  const std::size_t n = particles_.size();
+  if (n == 0) return dt;
+  double vmax = 0, cmax = 0;
+  {
+    const std::size_t chunks = (n + kParticleGrain - 1) / kParticleGrain;
+    std::vector<double> vm(chunks, 0.0), cm(chunks, 0.0);
+    parallel_for(
+        n, kParticleGrain,
+        [&](std::size_t b, std::size_t e) {
+          Real v2 = 0, c = 0;
+          for (std::size_t p = b; p < e; ++p) {
+            v2 = std::max(v2, particles_.v[p].squaredNorm());
+            const auto mat = particles_.material[p];
+            c = std::max(c, models_[mat].wave_speed(
+                                densities_[mat],
+                                particles_.has_plastic() ? particles_.plastic[p] : Real(1)));
+          }
+          vm[b / kParticleGrain] = std::sqrt(static_cast<double>(v2));
+          cm[b / kParticleGrain] = c;
+        },
+        opt_.serial);
+    vmax = *std::max_element(vm.begin(), vm.end());
+    cmax = *std::max_element(cm.begin(), cm.end());
+  }
+  if (vmax > 0) dt = std::min(dt, s.cfl * s.dx / vmax);
+  if (cmax > 0) dt = std::min(dt, s.cfl * s.dx / cmax);
+  return dt;
+}
+
+FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
+  using clock = std::chrono::steady_clock;
+  const auto wall0 = clock::now();
+  for (Stage& st : stages_) st.seconds = 0;
+  FrameStats fs;
+  fs.dt_min = 1e300;
+  double dt_seconds = 0;
+  while (time_ < t_end) {
+    const auto d0 = clock::now();
+    double dt = stable_dt();
+    const double remaining = t_end - time_;
+    if (dt < scene_.shot.dt_min && remaining > scene_.shot.dt_min) {
+      std::ostringstream os;
+      os << "at t = " << time_ << " s the stable step " << dt << " s is below shot.dt_min = "
+         << scene_.shot.dt_min << " s (max speed or stiffness too high for dx = "
+         << scene_.shot.dx << ")";
+      throw SimulationError(os.str());
+    }
+    const double steps = std::max(1.0, std::ceil(remaining / dt - 1e-9));
+    dt = remaining / steps;
+    dt_seconds += std::chrono::duration<double>(clock::now() - d0).count();
+    dt_ = dt;
+    for (Stage& st : stages_) {
+      const auto t0 = clock::now();
+      st.run();
+      st.seconds += std::chrono::duration<double>(clock::now() - t0).count();
+    }
+    time_ = (steps == 1.0) ? t_end : time_ + dt;
+    fs.substeps++;
+    fs.dt_min = std::min(fs.dt_min, dt);
+    fs.dt_max = std::max(fs.dt_max, dt);
+    if (cb) cb(fs.substeps, dt, time_);
+  }
+  if (fs.substeps == 0) fs.dt_min = 0;
+  // Reorder particles by grid block once per frame for memory locality.
+  const auto r0 = clock::now();
+  if (particles_.size() > 0) {
+    grid_.bin(particles_.x, opt_.serial);
+    particles_.permute(grid_.order);
+  }
+  const double reorder_seconds = std::chrono::duration<double>(clock::now() - r0).count();
+  fs.time = time_;
+  measure(fs);
+  for (const Stage& st : stages_) fs.stage_seconds.emplace_back(st.name, st.seconds);
+  if (!stages_.empty()) {
+    fs.stage_seconds.emplace_back("dt", dt_seconds);
+    fs.stage_seconds.emplace_back("reorder", reorder_seconds);
+  }
+  fs.wall_seconds = std::chrono::duration<double>(clock::now() - wall0).count();
+  return fs;
+}
+
+void Solver::measure(FrameStats& s) const {
+  const ParticleSet& p = particles_;
+  const std::size_t n = p.size();
+  s.particles = n;
+  s.grid_blocks = grid_.num_grid_blocks();
+  struct Acc {
+    double ke = 0, pe = 0, m = 0, vmax = 0;
+    Vec3d mom = Vec3d::Zero();
+    Acc& operator+=(const Acc& o) {
+      ke += o.ke;
+      pe += o.pe;
+      m += o.m;
+      mom += o.mom;
+      vmax = std::max(vmax, o.vmax);
+      return *this;
+    }
+  };
+  const Acc total = ordered_sum<Acc>(n, opt_.serial, Acc{}, [&](std::size_t i) {
+    Acc a;
+    const auto mat = p.material[i];
+    const double m = static_cast<double>(p.volume[i]) * densities_[mat];
+    const Vec3d v = p.v[i].cast<double>();
+    a.m = m;
+    a.ke = 0.5 * m * v.squaredNorm();
+    a.mom = m * v;
+    a.vmax = v.norm();
+    a.pe = static_cast<double>(p.volume[i]) *
+           models_[mat].energy(p.F[i], p.has_plastic() ? p.plastic[i] : Real(1));
+    return a;
+  });
+  s.kinetic_energy = total.ke;
+  s.elastic_energy = total.pe;
+  s.mass = total.m;
+  s.momentum = total.mom;
+  s.max_speed = total.vmax;
+}
+
+}  // namespace shellmpm

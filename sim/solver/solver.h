@@ -1,0 +1,86 @@
+// The step loop. The solver assembles its stages from the scene (only the effects a
+// scene calls for run): no bulk material means no transfer stages, no collider means
+// no collider stage, no plastic material means no plasticity stage, no emitting source
+// means no emission stage.
+#pragma once
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/collider/collider.h"
+#include "sim/mpm/constitutive.h"
+#include "sim/mpm/particles.h"
+#include "sim/mpm/sparse_grid.h"
+#include "sim/scene/scene.h"
+#include "sim/solver/frame_stats.h"
+#include "sim/solver/source_sampler.h"
+
+namespace shellmpm {
+
+/// Raised when the simulation cannot go on (e.g. the step needed falls below dt_min).
+struct SimulationError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct SolverOptions {
+  bool serial = false;     ///< no threads (tests compare against parallel runs)
+  bool fill_sources = true;  ///< sample fill sources at construction (off when resuming)
+};
+
+/// Called after every substep: substep index in the frame, dt taken, time reached.
+using SubstepCallback = std::function<void(int, double, double)>;
+
+class Solver {
+ public:
+  explicit Solver(const Scene& scene, SolverOptions opt = {});
+
+  /// Names of the stages this scene switches on, in execution order.
+  std::vector<std::string> stage_names() const;
+  /// Advances to absolute time t_end [s] in CFL-limited substeps; returns the frame's stats.
+  FrameStats advance_to(double t_end, const SubstepCallback& cb = {});
+  /// Computes the energy, momentum and speed entries of a FrameStats for the current state.
+  void measure(FrameStats& s) const;
+  /// The step the solver would take now, before splitting the remaining frame time.
+  double stable_dt() const;
+
+  double time() const { return time_; }
+  void set_time(double t) { time_ = t; }
+  ParticleSet& particles() { return particles_; }
+  const ParticleSet& particles() const { return particles_; }
+  const SparseGrid& grid() const { return grid_; }
+  const std::vector<ConstitutiveModel>& models() const { return models_; }
+  const std::vector<Real>& densities() const { return densities_; }
+  const std::vector<SourceSampler>& samplers() const { return samplers_; }
+  const Scene& scene() const { return scene_; }
+
+ private:
+  struct Stage {
+    std::string name;
+    std::function<void()> run;
+    double seconds = 0;
+  };
+  void build_stages();
+  void add_particles_from(std::size_t source, const std::vector<Vec3d>& pts);
+  void step(double dt);
+  void grid_update();
+  void apply_colliders();
+  void project_plasticity();
+  void emit();
+  void clamp_to_domain();
+
+  Scene scene_;
+  SolverOptions opt_;
+  std::vector<ConstitutiveModel> models_;
+  std::vector<Real> densities_;
+  std::vector<SourceSampler> samplers_;
+  std::vector<Collider> colliders_;
+  ParticleSet particles_;
+  SparseGrid grid_;
+  std::vector<Stage> stages_;
+  double time_ = 0, dt_ = 0;
+  Vec3i domain_cells_{0, 0, 0};
+  bool any_plastic_ = false, any_emit_ = false;
+};
+
+}  // namespace shellmpm

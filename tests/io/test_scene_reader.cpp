@@ -1,0 +1,647 @@
+// Tests of io/scene_reader: valid scenes, defaults, JSON, --set overrides, the error
+// messages for bad input (file, line, key path), and that docs/scene-format.md documents
+// exactly the keys, types, units, defaults and ranges the reader validates.
+#include <catch2/catch.hpp>
+
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "io/scene_reader.h"
+
+#ifndef SHELLMPM_SOURCE_DIR
+#error "SHELLMPM_SOURCE_DIR must be defined to the repository root"
+#endif
+
+using namespace shellmpm;
+
+namespace {
+
+const std::string kSource = SHELLMPM_SOURCE_DIR;
+const std::string kScenes = kSource + "/tests/data/scenes/";
+
+// A valid scene head; lines 1-4. Cases below append lines from line 5 on.
+const std::string kHead =
+    "version: 1\n"
+    "shot:\n"
+    "  domain: {min: [-1, -1, -1], max: [1, 1, 1]}\n"
+    "  dx: 0.1\n";
+
+const std::string kSand =  // lines 5-6 after kHead
+    "materials:\n"
+    "  - {name: sand, type: sand}\n";
+
+/// Runs `fn`, which must throw UserError; returns it.
+template <class Fn>
+UserError catch_user_error(Fn&& fn) {
+  try {
+    fn();
+  } catch (const UserError& e) {
+    return e;
+  }
+  FAIL("expected a UserError");
+  throw std::logic_error("unreachable");
+}
+
+/// Parses `text` as "scenes/bad.yaml" and checks the error's line, key and message parts.
+void expect_error(const std::string& text, int line, const std::string& key,
+                  const std::vector<std::string>& parts,
+                  const std::vector<std::string>& overrides = {}) {
+  CAPTURE(text);
+  const UserError e = catch_user_error([&] { parse_scene(text, "scenes/bad.yaml", overrides); });
+  const std::string what = e.what();
+  CAPTURE(what);
+  CHECK(e.file == "scenes/bad.yaml");
+  CHECK(e.line == line);
+  CHECK(e.key == key);
+  const std::string prefix = "scenes/bad.yaml" + (line > 0 ? ":" + std::to_string(line) : "") +
+                             ": " + (key.empty() ? "" : key + ": ");
+  CHECK(what.compare(0, prefix.size(), prefix) == 0);
+  for (const std::string& p : parts) CHECK(what.find(p) != std::string::npos);
+}
+
+/// Same for an error that comes from an override: reported at "--set KEY=VALUE", no line.
+void expect_override_error(const std::string& text, const std::string& ov, const std::string& key,
+                           const std::vector<std::string>& parts) {
+  const UserError e = catch_user_error([&] { parse_scene(text, "scenes/ok.yaml", {ov}); });
+  const std::string what = e.what();
+  CAPTURE(ov, what);
+  CHECK(e.file == "--set " + ov);
+  CHECK(e.line == 0);
+  CHECK(e.key == key);
+  const std::string prefix = "--set " + ov + ": " + (key.empty() ? "" : key + ": ");
+  CHECK(what.compare(0, prefix.size(), prefix) == 0);
+  for (const std::string& p : parts) CHECK(what.find(p) != std::string::npos);
+}
+
+bool vec_eq(const Vec3d& a, const Vec3d& b) {
+  return (a - b).cwiseAbs().maxCoeff() <= 1e-12;
+}
+
+std::string trim(const std::string& s) {
+  const std::size_t b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  const std::size_t e = s.find_last_not_of(" \t\r");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> split_row(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string t = trim(line);
+  if (t.size() < 2 || t.front() != '|' || t.back() != '|') return cells;
+  t = t.substr(1, t.size() - 2);
+  std::stringstream ss(t);
+  std::string cell;
+  while (std::getline(ss, cell, '|')) cells.push_back(trim(cell));
+  return cells;
+}
+
+}  // namespace
+
+TEST_CASE("a full scene parses with the values written", "[scene]") {
+  const Scene s = read_scene(kScenes + "full.yaml");
+  CHECK(s.path == kScenes + "full.yaml");
+
+  const ShotSettings& shot = s.shot;
+  CHECK(shot.frame_start == 2);
+  CHECK(shot.frame_end == 60);
+  CHECK(shot.fps == 30.0);
+  CHECK(shot.cfl == 0.5);
+  CHECK(shot.dt_min == 1e-7);
+  CHECK(shot.dt_max == 5e-3);
+  CHECK(vec_eq(shot.gravity, Vec3d(0, -3.5, 0.25)));
+  CHECK(vec_eq(shot.domain_min, Vec3d(-2, 0, -2)));
+  CHECK(vec_eq(shot.domain_max, Vec3d(2, 3, 2)));
+  CHECK(shot.dx == 0.05);
+  CHECK(shot.threads == 4);
+  CHECK(shot.transfer == "mls");
+  CHECK(shot.units == "cm");
+
+  REQUIRE(s.materials.size() == 3);
+  const MaterialDesc& sand = s.materials[0];
+  CHECK(sand.name == "sand");
+  CHECK(sand.kind == MaterialKind::Sand);
+  CHECK(sand.youngs_modulus == 3.5e5);
+  CHECK(sand.poisson_ratio == 0.29);
+  CHECK(sand.density == 1600.0);
+  CHECK(sand.friction_angle_deg == 35.0);
+  CHECK(sand.cohesion == 0.01);
+  const MaterialDesc& snow = s.materials[1];
+  CHECK(snow.kind == MaterialKind::Snow);
+  CHECK(snow.critical_compression == 0.02);
+  CHECK(snow.critical_stretch == 0.006);
+  CHECK(snow.hardening == 9.0);
+  CHECK(snow.density == 400.0);
+  const MaterialDesc& jelly = s.materials[2];
+  CHECK(jelly.kind == MaterialKind::Elastic);
+  CHECK(jelly.model == ElasticModel::NeoHookean);
+  CHECK(jelly.youngs_modulus == 2e4);
+
+  REQUIRE(s.sources.size() == 4);
+  const SourceDesc& pile = s.sources[0];
+  CHECK(pile.name == "pile");
+  CHECK(pile.material == 0);
+  CHECK(pile.shape.kind == ShapeDesc::Kind::Box);
+  CHECK(vec_eq(pile.shape.min, Vec3d(-0.5, 0, -0.5)));
+  CHECK(vec_eq(pile.shape.max, Vec3d(0.5, 1, 0.5)));
+  CHECK(pile.particles_per_cell == 16.0);
+  CHECK(pile.seed == 7u);
+  CHECK_FALSE(pile.emit);
+  const SourceDesc& flake = s.sources[1];
+  CHECK(flake.name == "source1");
+  CHECK(flake.material == 1);
+  CHECK(flake.shape.kind == ShapeDesc::Kind::Sphere);
+  CHECK(vec_eq(flake.shape.center, Vec3d(0, 2, 0)));
+  CHECK(flake.shape.radius == 0.25);
+  CHECK(vec_eq(flake.velocity, Vec3d(0, -1, 0)));
+  CHECK(flake.emit);
+  CHECK(flake.emit_start == 3);
+  CHECK(flake.emit_end == 30);
+  const SourceDesc& blob = s.sources[2];
+  CHECK(blob.shape.kind == ShapeDesc::Kind::Cylinder);
+  CHECK(vec_eq(blob.shape.axis, Vec3d(0, 1, 0)));  // normalized from [0, 2, 0]
+  CHECK(blob.shape.radius == 0.2);
+  CHECK(blob.shape.height == 0.5);
+  CHECK(vec_eq(blob.shape.center, Vec3d(1, 1, 1)));
+  const SourceDesc& rock = s.sources[3];
+  CHECK(rock.material == 2);
+  CHECK(rock.shape.kind == ShapeDesc::Kind::Mesh);
+  CHECK(rock.shape.mesh_path == kScenes + "tetra.obj");  // resolved next to the scene file
+  CHECK(rock.shape.mesh_scale == 0.5);
+  CHECK(vec_eq(rock.shape.mesh_translate, Vec3d(0, 1, 0)));
+  CHECK(rock.shape.sdf == nullptr);  // meshes are not loaded by the reader
+  CHECK(rock.shape.mesh_where == kScenes + "full.yaml:58: sources[3].shape.path");
+
+  REQUIRE(s.colliders.size() == 3);
+  const ColliderDesc& ground = s.colliders[0];
+  CHECK(ground.name == "ground");
+  CHECK(ground.shape.kind == ShapeDesc::Kind::Plane);
+  CHECK(vec_eq(ground.shape.normal, Vec3d(0, 1, 0)));  // normalized from [0, 3, 0]
+  CHECK(ground.boundary == BoundaryKind::Sticky);
+  CHECK(ground.keyframes.empty());
+  const ColliderDesc& paddle = s.colliders[1];
+  CHECK(paddle.boundary == BoundaryKind::Slip);
+  CHECK(paddle.friction == 0.4);
+  REQUIRE(paddle.keyframes.size() == 3);
+  CHECK(paddle.keyframes[0].time == 0.0);
+  CHECK(paddle.keyframes[1].time == Approx(23.0 / 30.0));  // frame N -> (N - 1) / fps
+  CHECK(vec_eq(paddle.keyframes[1].translate, Vec3d(1, 0, 0)));
+  CHECK(vec_eq(paddle.keyframes[1].rotate_deg, Vec3d(0, 90, 0)));
+  CHECK(paddle.keyframes[2].time == 2.5);
+  CHECK(vec_eq(paddle.keyframes[2].translate, Vec3d(0, 0, 0)));
+  CHECK(vec_eq(paddle.keyframes[2].rotate_deg, Vec3d(0, 180, 0)));
+  CHECK(s.colliders[2].name == "collider2");
+  CHECK(s.colliders[2].boundary == BoundaryKind::Separate);
+
+  const OutputSettings& o = s.output;
+  CHECK(o.directory == "/tmp/shellmpm_full");
+  CHECK_FALSE(o.density);
+  CHECK(o.density_pattern == "dens_####.vdb");
+  CHECK(o.velocity);
+  CHECK(o.half_float);
+  CHECK(o.voxel_size == 0.025);
+  CHECK(o.particles);
+  CHECK(o.particles_pattern == "p.######.bin");
+  CHECK(o.stats_file == "run.json");
+  CHECK(o.checkpoint_every == 10);
+}
+
+TEST_CASE("keys left out take the defaults of scene.h", "[scene]") {
+  const Scene s = read_scene(kScenes + "minimal.yaml");
+  const ShotSettings d;
+  CHECK(s.shot.frame_start == d.frame_start);
+  CHECK(s.shot.frame_end == d.frame_end);
+  CHECK(s.shot.fps == d.fps);
+  CHECK(s.shot.cfl == d.cfl);
+  CHECK(s.shot.dt_min == d.dt_min);
+  CHECK(s.shot.dt_max == d.dt_max);
+  CHECK(vec_eq(s.shot.gravity, d.gravity));
+  CHECK(s.shot.threads == d.threads);
+  CHECK(s.shot.transfer == d.transfer);
+  CHECK(s.shot.units == d.units);
+  CHECK(s.shot.dx == 0.1);
+  CHECK(s.materials.empty());
+  CHECK(s.sources.empty());
+  CHECK(s.colliders.empty());
+
+  const OutputSettings od;
+  CHECK(s.output.directory == od.directory);
+  CHECK(s.output.density == od.density);
+  CHECK(s.output.density_pattern == od.density_pattern);
+  CHECK(s.output.velocity == od.velocity);
+  CHECK(s.output.half_float == od.half_float);
+  CHECK(s.output.voxel_size == od.voxel_size);
+  CHECK(s.output.particles == od.particles);
+  CHECK(s.output.particles_pattern == od.particles_pattern);
+  CHECK(s.output.stats_file == od.stats_file);
+  CHECK(s.output.checkpoint_every == od.checkpoint_every);
+
+  // Materials, sources, colliders, keyframes and mesh shapes with only required keys.
+  const Scene m = parse_scene(kHead +
+                                  "materials:\n"
+                                  "  - {name: e, type: elastic}\n"
+                                  "  - {name: s, type: sand}\n"
+                                  "  - {name: w, type: snow}\n"
+                                  "sources:\n"
+                                  "  - {material: s, shape: {type: sphere, center: [0, 0, 0],"
+                                  " radius: 0.1}}\n"
+                                  "colliders:\n"
+                                  "  - shape: {type: mesh, path: tetra.obj}\n"
+                                  "    keyframes: [{time: 0}]\n",
+                              kScenes + "inline.yaml");
+  const MaterialDesc md;
+  REQUIRE(m.materials.size() == 3);
+  for (const MaterialDesc& mat : m.materials) {
+    CHECK(mat.youngs_modulus == md.youngs_modulus);
+    CHECK(mat.poisson_ratio == md.poisson_ratio);
+    CHECK(mat.density == md.density);
+  }
+  CHECK(m.materials[0].model == md.model);
+  CHECK(m.materials[1].friction_angle_deg == md.friction_angle_deg);
+  CHECK(m.materials[1].cohesion == md.cohesion);
+  CHECK(m.materials[2].critical_compression == md.critical_compression);
+  CHECK(m.materials[2].critical_stretch == md.critical_stretch);
+  CHECK(m.materials[2].hardening == md.hardening);
+
+  const SourceDesc sd;
+  REQUIRE(m.sources.size() == 1);
+  CHECK(m.sources[0].name == "source0");
+  CHECK(m.sources[0].material == 1);
+  CHECK(m.sources[0].particles_per_cell == sd.particles_per_cell);
+  CHECK(vec_eq(m.sources[0].velocity, sd.velocity));
+  CHECK(m.sources[0].seed == sd.seed);
+  CHECK(m.sources[0].emit == sd.emit);
+
+  const ColliderDesc cd;
+  const ShapeDesc shd;
+  const Keyframe kd;
+  REQUIRE(m.colliders.size() == 1);
+  CHECK(m.colliders[0].name == "collider0");
+  CHECK(m.colliders[0].boundary == cd.boundary);
+  CHECK(m.colliders[0].friction == cd.friction);
+  CHECK(m.colliders[0].shape.mesh_scale == shd.mesh_scale);
+  CHECK(vec_eq(m.colliders[0].shape.mesh_translate, shd.mesh_translate));
+  REQUIRE(m.colliders[0].keyframes.size() == 1);
+  CHECK(vec_eq(m.colliders[0].keyframes[0].translate, kd.translate));
+  CHECK(vec_eq(m.colliders[0].keyframes[0].rotate_deg, kd.rotate_deg));
+}
+
+TEST_CASE("JSON scenes are read like YAML", "[scene]") {
+  const Scene s = read_scene(kScenes + "minimal.json");
+  CHECK(s.shot.dx == 0.1);
+  CHECK(s.shot.frame_end == 10);
+  REQUIRE(s.materials.size() == 1);
+  CHECK(s.materials[0].density == 900.0);
+  REQUIRE(s.sources.size() == 1);
+  CHECK(s.sources[0].shape.kind == ShapeDesc::Kind::Sphere);
+  CHECK(s.output.directory == "json_out");
+
+  // JSON errors carry lines too; a quoted number is a string, not a number.
+  expect_error(
+      "{\n"
+      "  \"version\": 1,\n"
+      "  \"shot\": {\"domain\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]},\n"
+      "           \"dx\": \"0.1\"}\n"
+      "}\n",
+      4, "shot.dx", {"expected a number", "\"0.1\"", "without quotes"});
+}
+
+TEST_CASE("overrides (--set) change the document before validation", "[scene]") {
+  const std::string text = kHead + kSand +
+                           "sources:\n"
+                           "  - {material: sand, shape: {type: box, min: [0, 0, 0],"
+                           " max: [1, 1, 1]}}\n";
+  SECTION("scalars, vectors and list entries, both index spellings") {
+    const Scene s =
+        parse_scene(text, "scenes/ok.yaml",
+                    {"shot.dx=0.01", "shot.gravity=[0,-1,0]", "materials.0.density=1500",
+                     "materials[0].friction_angle=40", "sources[0].shape.max=[2, 2, 2]",
+                     "output.directory=/tmp/x", "shot.frames=[1, 10]"});
+    CHECK(s.shot.dx == 0.01);
+    CHECK(vec_eq(s.shot.gravity, Vec3d(0, -1, 0)));
+    CHECK(s.materials[0].density == 1500.0);
+    CHECK(s.materials[0].friction_angle_deg == 40.0);
+    CHECK(vec_eq(s.sources[0].shape.max, Vec3d(2, 2, 2)));
+    CHECK(s.output.directory == "/tmp/x");  // created: the file has no output block
+    CHECK(s.shot.frame_end == 10);
+  }
+  SECTION("a mesh path from an override is resolved next to the scene file") {
+    const std::string ov = "sources.0.shape={type: mesh, path: tetra.obj}";
+    const Scene s = parse_scene(text, kScenes + "ok.yaml", {ov});
+    CHECK(s.sources[0].shape.mesh_path == kScenes + "tetra.obj");
+    CHECK(s.sources[0].shape.mesh_where == "--set " + ov + ": sources[0].shape.path");
+  }
+  SECTION("later overrides win; a mapping value replaces the whole mapping") {
+    const Scene s = parse_scene(text, "scenes/ok.yaml",
+                                {"shot.dx=0.05", "shot.dx=0.025",
+                                 "sources.0.shape={type: sphere, center: [0,0,0], radius: 1}"});
+    CHECK(s.shot.dx == 0.025);
+    CHECK(s.sources[0].shape.kind == ShapeDesc::Kind::Sphere);
+  }
+  SECTION("unknown keys") {
+    expect_override_error(text, "shot.dxx=1", "shot.dxx",
+                          {"unknown key 'dxx' in shot (known: frames, fps,", "dx"});
+    expect_override_error(text, "shots.dx=1", "shots",
+                          {"unknown key 'shots' in the top level", "shot"});
+    expect_override_error(text, "materials[0].densty=1", "materials[0].densty",
+                          {"unknown key 'densty' in materials[0]", "density"});
+    expect_override_error(text, "shot.dx.value=1", "shot.dx.value",
+                          {"unknown key 'value' in shot.dx", "no sub-keys"});
+  }
+  SECTION("bad values are reported at the override") {
+    expect_override_error(text, "shot.dx=abc", "shot.dx", {"expected a number, got 'abc'"});
+    expect_override_error(text, "shot.dx=-1", "shot.dx", {"must be > 0, got -1"});
+    expect_override_error(text, "shot.gravity=[0,1]", "shot.gravity",
+                          {"expected a list of 3 numbers"});
+    expect_override_error(text, "materials.0.type=clay", "materials[0].type",
+                          {"expected one of elastic, sand, snow, got 'clay'"});
+    expect_override_error(text, "shot.dx=[0.1", "shot.dx", {"YAML syntax error"});
+    expect_override_error(text, "shot.dx=", "shot.dx", {"expected a number, got nothing"});
+  }
+  SECTION("bad key paths") {
+    expect_override_error(text, "materials[3].density=1", "materials[3]",
+                          {"index 3 is out of range: materials has 1 entry"});
+    expect_override_error(text, "colliders[0].friction=1", "colliders[0]",
+                          {"out of range: colliders has 0 entries"});
+    expect_override_error(text, "materials.density=1", "materials.density",
+                          {"materials is a list", "materials[0].density"});
+    expect_override_error(text, "shot[0]=1", "shot[0]", {"shot is not a list"});
+    expect_override_error(text, "shot.dx", "", {"expected KEY=VALUE"});
+    expect_override_error(text, "shot..dx=1", "", {"bad key path", "empty key name"});
+    expect_override_error(text, "materials[x].density=1", "", {"list index must be a number"});
+  }
+}
+
+TEST_CASE("bad scenes name the file, line and key", "[scene]") {
+  SECTION("wrong type") {
+    expect_error(kHead + "  fps: fast\n", 5, "shot.fps", {"expected a number, got 'fast'"});
+    expect_error(kHead + "  fps: \"24\"\n", 5, "shot.fps", {"without quotes"});
+    expect_error(kHead + "  threads: 2.5\n", 5, "shot.threads", {"expected an integer, got '2.5'"});
+    expect_error(kHead + "  fps:\n", 5, "shot.fps", {"expected a number, got nothing (null)"});
+    expect_error(kHead + "output: {density: yes}\n", 5, "output.density",
+                 {"expected true or false, got 'yes'"});
+    expect_error(kHead + "materials:\n", 5, "materials", {"expected a list", "[]"});
+    expect_error(kHead + "output: out\n", 5, "output", {"expected a mapping", "'out'"});
+    expect_error(kHead + "  fps: .inf\n", 5, "shot.fps", {"must be a finite number"});
+    expect_error(kHead + "  fps: 1e999\n", 5, "shot.fps", {"out of the range of a double"});
+  }
+  SECTION("missing required key") {
+    expect_error("version: 1\nshot:\n  dx: 0.1\n", 3, "shot.domain",
+                 {"required key 'domain' is missing"});
+    expect_error("version: 1\n", 1, "shot", {"required key 'shot' is missing"});
+    expect_error(kHead + "materials:\n  - {name: m}\n", 6, "materials[0].type",
+                 {"required key 'type' is missing", "elastic, sand, snow"});
+    expect_error(kHead + "colliders:\n  - shape: {type: sphere, center: [0, 0, 0]}\n", 6,
+                 "colliders[0].shape.radius", {"required key 'radius' is missing"});
+  }
+  SECTION("unknown keys, top-level and nested") {
+    expect_error(kHead + "colider: []\n", 5, "colider",
+                 {"unknown key 'colider' in the top level",
+                  "(known: version, shot, materials, sources, colliders, output)"});
+    expect_error(kHead + "  dxx: 0.2\n", 5, "shot.dxx",
+                 {"unknown key 'dxx' in shot (known: frames, fps, cfl,"});
+    expect_error(kHead + kSand + "sources:\n  - material: sand\n    colour: red\n", 9,
+                 "sources[0].colour", {"unknown key 'colour' in sources[0]"});
+    expect_error(kHead +
+                     "colliders:\n  - shape: {type: box, min: [0,0,0], max: [1,1,1],\n"
+                     "      size: 2}\n",
+                 7, "colliders[0].shape.size",
+                 {"unknown key 'size'", "known for type box: type, min, max"});
+  }
+  SECTION("out-of-range values") {
+    expect_error(kHead + "  cfl: 1.5\n", 5, "shot.cfl", {"must be in (0, 1], got 1.5"});
+    expect_error(kHead + "  frames: [0, 10]\n", 5, "shot.frames[0]", {"must be >= 1, got 0"});
+    expect_error(kHead + "  frames: [10, 5]\n", 5, "shot.frames",
+                 {"last frame 5 is before first frame 10"});
+    expect_error(kHead + "materials:\n  - {name: m, type: elastic, poisson_ratio: 0.5}\n", 6,
+                 "materials[0].poisson_ratio", {"must be in [0, 0.5), got 0.5"});
+    expect_error(kHead + "  dt_min: 0.1\n", 5, "shot.dt_min",
+                 {"dt_max (0.01) must be >= dt_min (0.1)"});
+    expect_error("version: 1\nshot:\n  domain: {min: [0, 0, 0], max: [1, 1, 1]}\n  dx: 1e-7\n", 4,
+                 "shot.dx", {"the domain is 10000000 cells along x", "2^20"});
+    expect_error("version: 1\nshot:\n  domain: {min: [0, 0, 0], max: [1, 0, 1]}\n  dx: 0.1\n", 3,
+                 "shot.domain.max", {"on y max = 0 <= min = 0"});
+    const UserError e = catch_user_error([] { read_scene(kScenes + "bad_range.yaml"); });
+    CHECK(std::string(e.what()) ==
+          kScenes + "bad_range.yaml:8: materials[0].density: must be > 0, got -3");
+  }
+  SECTION("bad enum") {
+    expect_error(kHead + "  transfer: flip\n", 5, "shot.transfer",
+                 {"expected one of apic, mls, got 'flip'"});
+    expect_error(kHead + "colliders:\n  - shape: {type: cone}\n", 6, "colliders[0].shape.type",
+                 {"expected one of plane, box, sphere, cylinder, mesh, got 'cone'"});
+  }
+  SECTION("missing mesh file") {
+    const UserError e = catch_user_error([] { read_scene(kScenes + "bad_missing_mesh.yaml"); });
+    CHECK(e.file == kScenes + "bad_missing_mesh.yaml");
+    CHECK(e.line == 11);
+    CHECK(e.key == "colliders[0].shape.path");
+    CHECK(std::string(e.what()).find("mesh file not found: " + kScenes + "no_such_mesh.obj") !=
+          std::string::npos);
+    expect_error(kHead + "colliders:\n  - shape: {type: mesh, path: /}\n", 6,
+                 "colliders[0].shape.path", {"not a regular file"});
+  }
+  SECTION("duplicate names and keys") {
+    expect_error(kHead + "materials:\n  - {name: sand, type: sand}\n  - {name: sand, type: snow}\n",
+                 7, "materials[1].name", {"duplicate material name 'sand' (also materials[0])"});
+    expect_error(kHead + "  dx: 0.2\n", 5, "shot.dx", {"duplicate key 'dx' (first at line 4)"});
+    expect_error(kHead + kSand +
+                     "sources:\n"
+                     "  - {name: a, material: sand, shape: {type: sphere, center: [0,0,0], "
+                     "radius: 1}}\n"
+                     "  - {name: a, material: sand, shape: {type: sphere, center: [0,0,0], "
+                     "radius: 1}}\n",
+                 9, "sources[1].name", {"duplicate source name 'a'"});
+  }
+  SECTION("unknown material reference") {
+    expect_error(kHead + kSand +
+                     "sources:\n  - {material: sandd, shape: {type: box, min: [0,0,0], "
+                     "max: [1,1,1]}}\n",
+                 8, "sources[0].material", {"unknown material 'sandd' (materials: sand)"});
+    expect_error(kHead +
+                     "sources:\n  - {material: sand, shape: {type: box, min: [0,0,0], "
+                     "max: [1,1,1]}}\n",
+                 6, "sources[0].material", {"no materials are defined"});
+  }
+  SECTION("YAML syntax errors") {
+    const UserError e = catch_user_error([] { read_scene(kScenes + "bad_syntax.yaml"); });
+    CHECK(e.file == kScenes + "bad_syntax.yaml");
+    CHECK(e.line >= 4);  // the unclosed '[' is on line 4; yaml-cpp notices it on line 5
+    CHECK(e.line <= 5);
+    CHECK(std::string(e.what()).find("YAML syntax error") != std::string::npos);
+    expect_error(kHead + "  fps: 24\n bad indent: 1\n", 6, "", {"YAML syntax error"});
+    expect_error(kHead + "---\nversion: 1\n", 0, "", {"2 YAML documents"});
+  }
+  SECTION("wrong vector length") {
+    expect_error(kHead + "  gravity: [0, -9.81]\n", 5, "shot.gravity",
+                 {"expected a list of 3 numbers [x, y, z], got a list of 2 items"});
+    expect_error(kHead + "  gravity: [0, g, 0]\n", 5, "shot.gravity[1]",
+                 {"expected a number, got 'g'"});
+    expect_error(kHead + "  frames: [1, 2, 3]\n", 5, "shot.frames",
+                 {"expected [first, last] frames"});
+  }
+  SECTION("keyframes must strictly increase in time") {
+    const std::string c =
+        "colliders:\n"
+        "  - shape: {type: sphere, center: [0, 0, 0], radius: 0.1}\n"
+        "    keyframes:\n"
+        "      - {time: 0}\n"
+        "      - {time: 1}\n"
+        "      - {time: 1, translate: [1, 0, 0]}\n";
+    expect_error(kHead + c, 10, "colliders[0].keyframes[2].time",
+                 {"strictly increase: 1 s is not after 1 s"});
+    // frame 24 at 24 fps is t = 1 s, the same as the key before it
+    const std::string f =
+        "colliders:\n"
+        "  - shape: {type: sphere, center: [0, 0, 0], radius: 0.1}\n"
+        "    keyframes:\n"
+        "      - {time: 1.0}\n"
+        "      - {frame: 24}\n";
+    expect_error(kHead + f, 9, "colliders[0].keyframes[1].frame", {"strictly increase"});
+    expect_error(kHead +
+                     "colliders:\n"
+                     "  - shape: {type: sphere, center: [0, 0, 0], radius: 0.1}\n"
+                     "    keyframes:\n"
+                     "      - {time: 1.0, frame: 24}\n",
+                 8, "colliders[0].keyframes[0]", {"either time or frame, not both"});
+    expect_error(kHead +
+                     "colliders:\n"
+                     "  - shape: {type: sphere, center: [0, 0, 0], radius: 0.1}\n"
+                     "    keyframes:\n"
+                     "      - {translate: [0, 0, 0]}\n",
+                 8, "colliders[0].keyframes[0]", {"needs a time (seconds) or a frame"});
+  }
+  SECTION("emission needs a nonzero velocity") {
+    expect_error(kHead + kSand +
+                     "sources:\n"
+                     "  - material: sand\n"
+                     "    shape: {type: sphere, center: [0, 0, 0], radius: 0.1}\n"
+                     "    emit: {frames: [1, 10]}\n",
+                 10, "sources[0].emit", {"nonzero velocity", "sources[0].velocity"});
+  }
+  SECTION("version missing or wrong, checked first") {
+    expect_error("shot: {domain: {min: [0,0,0], max: [1,1,1]}, dx: 0.1}\n", 1, "version",
+                 {"required key 'version' is missing"});
+    expect_error("version: 2\nnew_key_of_v2: 1\n", 1, "version", {"must be 1, got 2"});
+  }
+  SECTION("keys of one material type on another") {
+    expect_error(kHead + "materials:\n  - {name: j, type: elastic, friction_angle: 30}\n", 6,
+                 "materials[0].friction_angle",
+                 {"'friction_angle' is not allowed for type elastic (only for sand"});
+    expect_error(kHead + "materials:\n  - {name: s, type: sand, model: neo_hookean}\n", 6,
+                 "materials[0].model", {"not allowed for type sand (only for elastic"});
+    expect_error(kHead + "materials:\n  - {name: s, type: sand, hardening: 3}\n", 6,
+                 "materials[0].hardening", {"only for snow"});
+  }
+  SECTION("shapes") {
+    expect_error(kHead + kSand +
+                     "sources:\n  - {material: sand, shape: {type: plane, point: [0,0,0], "
+                     "normal: [0,1,0]}}\n",
+                 8, "sources[0].shape.type", {"a plane cannot be a source"});
+    expect_error(kHead +
+                     "colliders:\n  - shape: {type: sphere, center: [0,0,0], radius: 1, "
+                     "min: [0,0,0]}\n",
+                 6, "colliders[0].shape.min",
+                 {"'min' is not allowed for type sphere", "keys for sphere: type, center, radius"});
+    expect_error(kHead + "colliders:\n  - shape: {type: plane, point: [0,0,0], normal: [0,0,0]}\n",
+                 6, "colliders[0].shape.normal", {"nonzero"});
+    expect_error(kHead + "colliders:\n  - shape: {type: box, min: [0,0,0], max: [1,1,-1]}\n", 6,
+                 "colliders[0].shape.max", {"on z max = -1 <= min = 0"});
+  }
+  SECTION("output patterns") {
+    expect_error(kHead + "output:\n  density_pattern: density.vdb\n", 6, "output.density_pattern",
+                 {"exactly one run of '#'", "'density.vdb'"});
+    expect_error(kHead + "output:\n  particles_pattern: p.##.#.bin\n", 6,
+                 "output.particles_pattern", {"exactly one run of '#'"});
+  }
+  SECTION("the document itself") {
+    expect_error("", 0, "", {"the scene is empty"});
+    expect_error("- version: 1\n", 1, "", {"expected a mapping of keys at the top level"});
+    const UserError e = catch_user_error([] { read_scene(kScenes + "no_such_scene.yaml"); });
+    CHECK(e.file == kScenes + "no_such_scene.yaml");
+    CHECK(e.line == 0);
+    CHECK(std::string(e.what()).find("cannot open scene file") != std::string::npos);
+  }
+}
+
+TEST_CASE("docs/scene-format.md documents exactly the schema", "[scene]") {
+  std::ifstream in(kSource + "/docs/scene-format.md");
+  REQUIRE(in);
+  std::map<std::string, int> column;  // header name -> index, for the current table
+  std::map<std::string, std::vector<std::string>> documented;  // key -> its row
+  std::map<std::string, std::map<std::string, int>> columns_of;
+  std::string line;
+  int tables = 0;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> cells = split_row(line);
+    if (cells.empty()) {
+      column.clear();
+      continue;
+    }
+    if (cells[0] == "Key") {
+      column.clear();
+      for (std::size_t i = 0; i < cells.size(); ++i) column[cells[i]] = static_cast<int>(i);
+      ++tables;
+      continue;
+    }
+    if (column.empty() || cells[0].find_first_not_of("-: ") == std::string::npos) continue;
+    REQUIRE(cells[0].size() > 2);
+    REQUIRE(cells[0].front() == '`');
+    REQUIRE(cells[0].back() == '`');
+    const std::string key = cells[0].substr(1, cells[0].size() - 2);
+    CAPTURE(key);
+    CHECK(documented.count(key) == 0);  // each key documented once
+    documented[key] = cells;
+    columns_of[key] = column;
+  }
+  CHECK(tables >= 7);
+
+  std::set<std::string> schema_keys;
+  for (const KeySpec& s : scene_schema()) {
+    CAPTURE(s.key);
+    CHECK(schema_keys.insert(s.key).second);
+    for (const std::string& text :
+         {s.type_text(), s.unit_text(), s.default_text(), s.range_text(), s.only_for_text()}) {
+      CHECK(text.find('|') == std::string::npos);  // would break the markdown table
+    }
+    auto it = documented.find(s.key);
+    if (it == documented.end()) {
+      FAIL_CHECK("schema key " << s.key << " is not documented in docs/scene-format.md");
+      continue;
+    }
+    const std::vector<std::string>& row = it->second;
+    const std::map<std::string, int>& col = columns_of[s.key];
+    auto cell = [&](const char* name) -> std::string {
+      auto c = col.find(name);
+      if (c == col.end() || c->second >= static_cast<int>(row.size())) return "<no column>";
+      return row[c->second];
+    };
+    CHECK(cell("Type") == s.type_text());
+    CHECK(cell("Unit") == s.unit_text());
+    CHECK(cell("Default") == s.default_text());
+    CHECK(cell("Range") == s.range_text());
+    if (col.count("Only for")) {
+      CHECK(cell("Only for") == s.only_for_text());
+    } else {
+      CHECK(s.only_for.empty());  // a table without the column holds no type-specific keys
+    }
+  }
+  for (const auto& [key, row] : documented) {
+    CAPTURE(key);
+    CHECK(schema_keys.count(key) == 1);  // documented keys exist
+  }
+}
+
+TEST_CASE("schema entries are consistent", "[scene]") {
+  for (const KeySpec& s : scene_schema()) {
+    CAPTURE(s.key);
+    // Required keys have no default; Default keys have one (applied and validated on read).
+    CHECK((s.presence == Presence::Required) == s.default_value.empty());
+    CHECK((s.type == KeyType::Enum) == !s.choices.empty());
+    if (s.unit_vector) CHECK(s.type == KeyType::Vec3);
+    if (s.nonempty) CHECK(s.type == KeyType::String);
+  }
+}
