@@ -1,5 +1,6 @@
 #include "sim/mpm/transfer.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "sim/core/parallel.h"
@@ -8,23 +9,55 @@
 namespace shellmpm {
 namespace {
 
+// Kirchhoff stresses of one particle block, in block order, computed in SIMD batches
+// over runs of particles that share a material.
+void block_stresses(const ParticleSet& p, const SparseGrid& grid, const TransferParams& tp,
+                    std::size_t b, std::vector<Mat3>& F, std::vector<Real>& pl,
+                    std::vector<Mat3>& tau) {
+  const std::uint32_t s0 = grid.pblock_start[b], s1 = grid.pblock_start[b + 1];
+  const std::size_t n = s1 - s0;
+  F.resize(n);
+  pl.resize(n);
+  tau.resize(n);
+  const bool plastic = p.has_plastic();
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t q = grid.order[s0 + i];
+    F[i] = p.F[q];
+    pl[i] = plastic ? p.plastic[q] : Real(0);
+  }
+  if (!tp.stress) {
+    std::fill(tau.begin(), tau.end(), Mat3::Zero());
+    return;
+  }
+  std::size_t i = 0;
+  while (i < n) {
+    const auto mat = p.material[grid.order[s0 + i]];
+    std::size_t j = i + 1;
+    while (j < n && p.material[grid.order[s0 + j]] == mat) ++j;
+    (*tp.models)[mat].kirchhoff_batch(F.data() + i, plastic ? pl.data() + i : nullptr,
+                                      tau.data() + i, j - i);
+    i = j;
+  }
+}
+
 template <bool kMls>
 void p2g_block(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp, std::size_t b) {
+  thread_local std::vector<Mat3> F_local, tau_local;
+  thread_local std::vector<Real> pl_local;
+  block_stresses(p, grid, tp, b, F_local, pl_local, tau_local);
   auto& buf = grid.pblock_buf[b];
   std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
   const Real dt = tp.dt;
-  const auto& models = *tp.models;
   const auto& rho = *tp.densities;
-  const bool plastic = p.has_plastic();
-  for (std::uint32_t s = grid.pblock_start[b]; s < grid.pblock_start[b + 1]; ++s) {
+  const std::uint32_t s0 = grid.pblock_start[b];
+  for (std::uint32_t s = s0; s < grid.pblock_start[b + 1]; ++s) {
     const std::uint32_t q = grid.order[s];
     const QuadraticWeights W(grid.grid_coord(p.x[q]));
     const Real vol = p.volume[q];
     const Real m = vol * rho[p.material[q]];
-    Mat3 tau = Mat3::Zero();
-    if (tp.stress) tau = models[p.material[q]].kirchhoff(p.F[q], plastic ? p.plastic[q] : Real(1));
+    const Mat3& tau = tau_local[s - s0];
     // Affine term in grid units: dpos_grid = node - fx, world dpos = dx * dpos_grid.
     Mat3 A = (m * dx) * p.C[q];
     Mat3 S = Mat3::Zero();

@@ -161,12 +161,19 @@ void Solver::apply_colliders() {
 }
 
 void Solver::project_plasticity() {
+  // Runs of one material in storage order go through the SIMD batch return mapping.
   parallel_for(
       particles_.size(), kParticleGrain,
       [&](std::size_t b, std::size_t e) {
-        for (std::size_t p = b; p < e; ++p) {
-          const ConstitutiveModel& m = models_[particles_.material[p]];
-          if (m.has_plasticity()) m.project(particles_.F[p], particles_.plastic[p]);
+        std::size_t i = b;
+        while (i < e) {
+          const auto mat = particles_.material[i];
+          std::size_t j = i + 1;
+          while (j < e && particles_.material[j] == mat) ++j;
+          const ConstitutiveModel& m = models_[mat];
+          if (m.has_plasticity())
+            m.project_batch(particles_.F.data() + i, particles_.plastic.data() + i, j - i);
+          i = j;
         }
       },
       opt_.serial);
