@@ -38,20 +38,38 @@ int check_command(const CommonArgs& a) {
   grid.bin(solver.particles().x);
   std::printf("grid blocks: %zu (4x4x4 nodes) around %zu particle blocks\n", grid.num_grid_blocks(),
               grid.num_particle_blocks());
-  const double per_particle = static_cast<double>(solver.particles().bytes()) /
-                                  std::max<std::size_t>(n0, 1) + 8.0;
-  const double mem = per_particle * static_cast<double>(n0 + emitted) +
-                     static_cast<double>(grid.bytes()) * (n0 + emitted) / std::max<std::size_t>(n0, 1);
-  std::printf("memory: about %.1f MiB\n", mem / (1024.0 * 1024.0));
-  const double dt = solver.stable_dt();
+  const std::size_t peak = n0 + emitted;
+  // Bytes per particle from the particle arrays plus the grid share measured in
+  // bench/mpm_throughput (about 21 B/particle at 8 particles per cell).
+  const double per_particle = static_cast<double>(sizeof(Vec3) * 2 + sizeof(Mat3) * 2 +
+                                                  sizeof(Real) * 2 + 2 + 4) + 8.0;
+  const double grid_bytes = n0 > 0 ? static_cast<double>(grid.bytes()) / n0 : 21.0;
+  const double mem = (per_particle + grid_bytes) * static_cast<double>(peak);
+  std::printf("memory: about %.1f MiB at the peak of %zu particles\n", mem / (1024.0 * 1024.0), peak);
+  // The step: CFL on the current particles, plus the sources' speeds and the wave speeds
+  // of the materials that are still to be emitted.
+  double dt = solver.stable_dt();
+  for (const SourceDesc& src : scene.sources) {
+    const double v = src.velocity.norm();
+    if (v > 0) dt = std::min(dt, s.cfl * s.dx / v);
+    const ConstitutiveModel& m = solver.models()[src.material];
+    const double c = m.wave_speed(solver.densities()[src.material], m.initial_plastic());
+    if (c > 0) dt = std::min(dt, s.cfl * s.dx / c);
+  }
   const double steps = std::ceil(1.0 / s.fps / dt);
+  double harden = 1;
+  for (const ConstitutiveModel& m : solver.models())
+    harden = std::max(harden, static_cast<double>(std::sqrt(m.hardening(m.jp_min))));
+  if (harden > 1.01)
+    std::printf("note: compressed snow hardens; its step can get up to %.1fx smaller than this\n",
+                harden);
   // Throughput from bench/mpm_throughput on the reference machine, per thread.
   constexpr double kParticleStepsPerSecondPerThread = 2.5e6;
   const int threads = ThreadLimit::active();
-  const double sec = steps * static_cast<double>(n0 + emitted) /
-                     (kParticleStepsPerSecondPerThread * threads);
-  std::printf("time step at start: %.3g s (%g substeps per frame)\n", dt, steps);
-  std::printf("estimated time per frame: %.2f s on %d threads (at %.1fM particle-steps/s/thread)\n",
+  const double sec =
+      steps * static_cast<double>(peak) / (kParticleStepsPerSecondPerThread * threads);
+  std::printf("time step: about %.3g s (%g substeps per frame)\n", dt, steps);
+  std::printf("estimated time per frame at the peak: %.2f s on %d threads (at %.1fM particle-steps/s/thread)\n",
               sec, threads, kParticleStepsPerSecondPerThread / 1e6);
   return kExitOk;
 }

@@ -89,11 +89,10 @@ void bench_models(const char* name, std::size_t n, int reps) {
   nh.model = ElasticModel::NeoHookean;
   sand.kind = MaterialKind::Sand;
   snow.kind = MaterialKind::Snow;
-  const Entry entries[] = {{"fixed corotated", fcr}, {"neo-Hookean", nh}, {"sand", sand},
-                           {"snow", snow}};
+  const Entry entries[] = {
+      {"fixed corotated", fcr}, {"neo-Hookean", nh}, {"sand", sand}, {"snow", snow}};
   std::printf("%s, ns per particle (per call | batch call)\n", name);
-  std::printf("  %-16s %18s %18s %26s\n", "model", "kirchhoff", "project",
-              "project_and_kirchhoff");
+  std::printf("  %-16s %18s %18s %26s\n", "model", "kirchhoff", "project", "project_and_kirchhoff");
   for (const Entry& e : entries) {
     const Model m = Model::from_desc(e.desc);
     std::vector<M> F = F0, tau(n);
@@ -101,8 +100,8 @@ void bench_models(const char* name, std::size_t n, int reps) {
     const double k1 = ns_per_item(n, reps, [&]() {
       for (std::size_t i = 0; i < n; ++i) tau[i] = m.kirchhoff(F0[i], plastic[i]);
     });
-    const double kb =
-        ns_per_item(n, reps, [&]() { m.kirchhoff_batch(F0.data(), plastic.data(), tau.data(), n); });
+    const double kb = ns_per_item(
+        n, reps, [&]() { m.kirchhoff_batch(F0.data(), plastic.data(), tau.data(), n); });
     // project changes F and plastic: restore them before each pass (cost included; it is
     // a copy of 40 bytes per particle).
     const double p1 = ns_per_item(n, reps, [&]() {
@@ -130,8 +129,8 @@ void bench_models(const char* name, std::size_t n, int reps) {
       m.project_and_kirchhoff_batch(F.data(), plastic.data(), tau.data(), n);
     });
     g_sink = g_sink + tau[n / 2](0, 0) + F[n / 2](0, 0);
-    std::printf("  %-16s %8.1f | %7.1f %8.1f | %7.1f %12.1f | %7.1f\n", e.label, k1, kb, p1, pb,
-                c1, cb);
+    std::printf("  %-16s %8.1f | %7.1f %8.1f | %7.1f %12.1f | %7.1f\n", e.label, k1, kb, p1, pb, c1,
+                cb);
   }
 }
 
@@ -155,8 +154,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "svd_bench: --n and --reps must be positive\n");
     return 2;
   }
-  std::printf("svd_bench: %zu matrices F = R (I + 0.2 N), best of %d repetitions, 1 thread\n",
-              n, reps);
+  std::printf("svd_bench: %zu matrices F = R (I + 0.2 N), best of %d repetitions, 1 thread\n", n,
+              reps);
   bench_svd<float>("float", n, reps);
   bench_svd<double>("double", n, reps);
   bench_models<float>("float", n, reps);

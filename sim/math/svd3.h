@@ -86,20 +86,19 @@ struct SvdMask {
   typename SvdPack<T, K>::P m[K];
 };
 
-#define SHELLMPM_SVD3_PACK_BINOP(OP, FN)                                              \
-  template <class T, int K>                                                           \
-  SHELLMPM_SVD3_INLINE SvdPack<T, K> operator OP(const SvdPack<T, K>& a,              \
-                                                 const SvdPack<T, K>& b) {            \
-    SvdPack<T, K> r;                                                                  \
-    for (int i = 0; i < K; ++i) r.p[i] = Eigen::internal::FN(a.p[i], b.p[i]);         \
-    return r;                                                                         \
-  }                                                                                   \
-  template <class T, int K>                                                           \
-  SHELLMPM_SVD3_INLINE SvdPack<T, K> operator OP(T a, const SvdPack<T, K>& b) {       \
-    SvdPack<T, K> r;                                                                  \
-    const auto pa = Eigen::internal::pset1<typename SvdPack<T, K>::P>(a);             \
-    for (int i = 0; i < K; ++i) r.p[i] = Eigen::internal::FN(pa, b.p[i]);             \
-    return r;                                                                         \
+#define SHELLMPM_SVD3_PACK_BINOP(OP, FN)                                                           \
+  template <class T, int K>                                                                        \
+  SHELLMPM_SVD3_INLINE SvdPack<T, K> operator OP(const SvdPack<T, K>& a, const SvdPack<T, K>& b) { \
+    SvdPack<T, K> r;                                                                               \
+    for (int i = 0; i < K; ++i) r.p[i] = Eigen::internal::FN(a.p[i], b.p[i]);                      \
+    return r;                                                                                      \
+  }                                                                                                \
+  template <class T, int K>                                                                        \
+  SHELLMPM_SVD3_INLINE SvdPack<T, K> operator OP(T a, const SvdPack<T, K>& b) {                    \
+    SvdPack<T, K> r;                                                                               \
+    const auto pa = Eigen::internal::pset1<typename SvdPack<T, K>::P>(a);                          \
+    for (int i = 0; i < K; ++i) r.p[i] = Eigen::internal::FN(pa, b.p[i]);                          \
+    return r;                                                                                      \
   }
 SHELLMPM_SVD3_PACK_BINOP(+, padd)
 SHELLMPM_SVD3_PACK_BINOP(-, psub)
@@ -265,22 +264,25 @@ SHELLMPM_SVD3_INLINE void svd3_givens_rows(L (&b)[3][3], L (&u)[3][3]) {
   }
 }
 
-/// The whole algorithm on lanes. a: input (a[col][row]), overwritten. Outputs u, v
-/// (u[col][row]) and sigma.
+/// The whole algorithm on lanes. a_in: input (a_in[col][row]); outputs u_out, v_out
+/// (u[col][row]) and sigma_out. Works on local copies so that the compiler can keep
+/// everything in registers whether or not the call is inlined (it is large, so it is not
+/// forced inline; a call costs nothing next to its latency).
 template <class L>
-SHELLMPM_SVD3_INLINE void svd3_lanes(L (&a)[3][3], L (&u)[3][3], L (&sigma)[3],
-                                     L (&v)[3][3]) {
+inline void svd3_lanes(const L (&a_in)[3][3], L (&u_out)[3][3], L (&sigma_out)[3],
+                       L (&v_out)[3][3]) {
   using Ops = SvdLane<L>;
   using T = typename Ops::Scalar;
+  L a[3][3], u[3][3], v[3][3];
   // 1. Scale so max |a_ij| = 1 (a zero matrix is left as is).
-  L m = Ops::abs(a[0][0]);
+  L m = Ops::abs(a_in[0][0]);
   for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i) m = Ops::max(m, Ops::abs(a[j][i]));
+    for (int i = 0; i < 3; ++i) m = Ops::max(m, Ops::abs(a_in[j][i]));
   const L mm = Ops::select(m > std::numeric_limits<T>::min(), m, Ops::constant(T(1)));
   const L scale = T(1) / mm;
   for (int j = 0; j < 3; ++j)
     for (int i = 0; i < 3; ++i) {
-      a[j][i] = a[j][i] * scale;
+      a[j][i] = a_in[j][i] * scale;
       v[j][i] = Ops::constant(i == j ? T(1) : T(0));
       u[j][i] = Ops::constant(i == j ? T(1) : T(0));
     }
@@ -303,7 +305,13 @@ SHELLMPM_SVD3_INLINE void svd3_lanes(L (&a)[3][3], L (&u)[3][3], L (&sigma)[3],
   svd3_givens_rows<L, 0, 0, 1>(a, u);
   svd3_givens_rows<L, 0, 0, 2>(a, u);
   svd3_givens_rows<L, 1, 1, 2>(a, u);
-  for (int j = 0; j < 3; ++j) sigma[j] = a[j][j] * mm;
+  for (int j = 0; j < 3; ++j) {
+    sigma_out[j] = a[j][j] * mm;
+    for (int i = 0; i < 3; ++i) {
+      u_out[j][i] = u[j][i];
+      v_out[j][i] = v[j][i];
+    }
+  }
 }
 
 }  // namespace detail
@@ -349,9 +357,8 @@ constexpr int svd3_batch_width() {
 /// svd3_batch_width<T>() matrices per pass, one per SIMD lane, and pads the tail with
 /// zeros. U, sigma, V must hold n entries each; any of them may be nullptr to skip it.
 template <class T>
-inline void svd3_batch(const Eigen::Matrix<T, 3, 3>* A, std::size_t n,
-                       Eigen::Matrix<T, 3, 3>* U, Eigen::Matrix<T, 3, 1>* sigma,
-                       Eigen::Matrix<T, 3, 3>* V) {
+inline void svd3_batch(const Eigen::Matrix<T, 3, 3>* A, std::size_t n, Eigen::Matrix<T, 3, 3>* U,
+                       Eigen::Matrix<T, 3, 1>* sigma, Eigen::Matrix<T, 3, 3>* V) {
   static_assert(std::is_floating_point<T>::value, "svd3_batch needs float or double");
   using L = detail::Svd3BatchLane<T>;
   using P = typename L::P;

@@ -81,12 +81,12 @@ struct ConstitutiveModelT {
 
   MaterialKind kind = MaterialKind::Elastic;
   ElasticModel elastic = ElasticModel::FixedCorotated;  ///< used when kind == Elastic
-  T mu = T(0), lambda = T(0);      ///< Lame parameters (3D) from E, nu [Pa]
-  T alpha = T(0);                  ///< sand: Drucker-Prager alpha (dimensionless)
-  T cohesion = T(0);               ///< sand: cone tip offset, a Hencky strain (>= 0)
+  T mu = T(0), lambda = T(0);                           ///< Lame parameters (3D) from E, nu [Pa]
+  T alpha = T(0);                    ///< sand: Drucker-Prager alpha (dimensionless)
+  T cohesion = T(0);                 ///< sand: cone tip offset, a Hencky strain (>= 0)
   T theta_c = T(0), theta_s = T(0);  ///< snow: critical compression, stretch
-  T xi = T(0);                     ///< snow: hardening coefficient
-  T jp_min = T(1), jp_max = T(1);  ///< snow: clamp of J_P
+  T xi = T(0);                       ///< snow: hardening coefficient
+  T jp_min = T(1), jp_max = T(1);    ///< snow: clamp of J_P
 
   /// Model from a scene material. mu = E / (2 (1 + nu)), lambda = E nu / ((1 + nu)(1 - 2
   /// nu)); sand alpha = sqrt(2/3) 2 sin(phi) / (3 - sin(phi)). Checks the ranges
@@ -136,8 +136,8 @@ struct ConstitutiveModelT {
     return !(kind == MaterialKind::Elastic && elastic == ElasticModel::NeoHookean);
   }
   template <bool kProject, bool kStress>
-  void batch_impl(Mat3T* F_inout, const Mat3T* F_in, T* plastic_inout,
-                  const T* plastic_in, Mat3T* tau, std::size_t n) const;
+  void batch_impl(Mat3T* F_inout, const Mat3T* F_in, T* plastic_inout, const T* plastic_in,
+                  Mat3T* tau, std::size_t n) const;
 };
 
 /// The model in the simulation precision.
@@ -207,8 +207,7 @@ inline ConstitutiveModelT<T> ConstitutiveModelT<T>::from_desc(const MaterialDesc
     SHELLMPM_CHECK(d.critical_stretch >= 0.0,
                    "material '" << d.name << "': theta_s = " << d.critical_stretch);
     SHELLMPM_CHECK(d.hardening >= 0.0, "material '" << d.name << "': xi = " << d.hardening);
-    SHELLMPM_CHECK(d.max_hardening_jp_min > 0.0 &&
-                       d.max_hardening_jp_min <= d.max_hardening_jp_max,
+    SHELLMPM_CHECK(d.max_hardening_jp_min > 0.0 && d.max_hardening_jp_min <= d.max_hardening_jp_max,
                    "material '" << d.name << "': jp range [" << d.max_hardening_jp_min << ", "
                                 << d.max_hardening_jp_max << "]");
     m.theta_c = T(d.critical_compression);
@@ -264,8 +263,8 @@ inline bool ConstitutiveModelT<T>::project_sigma(Vec3T& sigma, T& plastic) const
     // Stomakhin et al. 2013: clamp the elastic singular values, move the volume change
     // into J_P.
     const T lo = T(1) - theta_c, hi = T(1) + theta_s;
-    if (sigma(0) >= lo && sigma(0) <= hi && sigma(1) >= lo && sigma(1) <= hi &&
-        sigma(2) >= lo && sigma(2) <= hi)
+    if (sigma(0) >= lo && sigma(0) <= hi && sigma(1) >= lo && sigma(1) <= hi && sigma(2) >= lo &&
+        sigma(2) <= hi)
       return false;
     const T j_old = sigma(0) * sigma(1) * sigma(2);
     for (int i = 0; i < 3; ++i) sigma(i) = std::min(std::max(sigma(i), lo), hi);
@@ -298,8 +297,8 @@ inline T ConstitutiveModelT<T>::energy(const Mat3T& F, T plastic) const {
 }
 
 template <class T>
-inline typename ConstitutiveModelT<T>::Mat3T ConstitutiveModelT<T>::first_piola(
-    const Mat3T& F, T plastic) const {
+inline typename ConstitutiveModelT<T>::Mat3T ConstitutiveModelT<T>::first_piola(const Mat3T& F,
+                                                                                T plastic) const {
   if (kind == MaterialKind::Elastic && elastic == ElasticModel::NeoHookean) {
     // P = mu F + (lambda log J_c - mu) cof(F) / J_c; exact for J > kNeoHookeanMinJ.
     const T Jc = std::max(F.determinant(), kNeoHookeanMinJ);
@@ -325,8 +324,8 @@ inline typename ConstitutiveModelT<T>::Mat3T ConstitutiveModelT<T>::first_piola(
 }
 
 template <class T>
-inline typename ConstitutiveModelT<T>::Mat3T ConstitutiveModelT<T>::kirchhoff(
-    const Mat3T& F, T plastic) const {
+inline typename ConstitutiveModelT<T>::Mat3T ConstitutiveModelT<T>::kirchhoff(const Mat3T& F,
+                                                                              T plastic) const {
   if (!uses_svd()) {
     // Neo-Hookean: tau = mu (F F^T - I) + lambda log J_c I.
     const T lj = std::log(std::max(F.determinant(), kNeoHookeanMinJ));
@@ -367,9 +366,9 @@ inline T ConstitutiveModelT<T>::wave_speed(T density, T plastic) const {
 
 template <class T>
 template <bool kProject, bool kStress>
-inline void ConstitutiveModelT<T>::batch_impl(Mat3T* F_inout, const Mat3T* F_in,
-                                              T* plastic_inout, const T* plastic_in,
-                                              Mat3T* tau, std::size_t n) const {
+inline void ConstitutiveModelT<T>::batch_impl(Mat3T* F_inout, const Mat3T* F_in, T* plastic_inout,
+                                              const T* plastic_in, Mat3T* tau,
+                                              std::size_t n) const {
   constexpr int W = svd3_batch_width<T>();
   Mat3T U[W], V[W];
   Vec3T sigma[W];

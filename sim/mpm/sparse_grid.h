@@ -67,6 +67,20 @@ class SparseGrid {
   std::vector<std::array<int, 8>> gblock_src;  ///< particle block at key - o, or -1
   std::vector<std::array<GridNode, kBlockNodes>> gblock_nodes;
 
+  /// Calls f(node, index) for every node of grid block b that has mass; index is the
+  /// node's global grid index.
+  template <class F>
+  void for_each_massive_node(std::size_t b, F&& f) {
+    const Vec3i c = unpack_block(gblock_key[b]) * kBlockSize;
+    auto& nodes = gblock_nodes[b];
+    for (int i = 0; i < kBlockSize; ++i)
+      for (int j = 0; j < kBlockSize; ++j)
+        for (int k = 0; k < kBlockSize; ++k) {
+          GridNode& nd = nodes[block_node(i, j, k)];
+          if (nd.m > 0) f(nd, Vec3i(c[0] + i, c[1] + j, c[2] + k));
+        }
+  }
+
   /// Sums every particle block's buffer into the grid blocks (fixed order).
   void gather_buffers_to_grid(bool serial = false);
   /// Copies grid node values into each particle block's padded buffer.

@@ -106,24 +106,16 @@ void Solver::grid_update() {
   parallel_for(
       grid_.num_grid_blocks(), 16,
       [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          const Vec3i c = unpack_block(grid_.gblock_key[b]) * kBlockSize;
-          auto& nodes = grid_.gblock_nodes[b];
-          for (int i = 0; i < kBlockSize; ++i)
-            for (int j = 0; j < kBlockSize; ++j)
-              for (int k = 0; k < kBlockSize; ++k) {
-                GridNode& nd = nodes[block_node(i, j, k)];
-                if (nd.m <= 0) continue;
-                const Real inv_m = Real(1) / nd.m;
-                const int n[3] = {c[0] + i, c[1] + j, c[2] + k};
-                for (int a = 0; a < 3; ++a) {
-                  Real v = nd.v[a] * inv_m + dt * g[a];
-                  if (n[a] < kWallCells && v < 0) v = 0;
-                  if (n[a] > domain_cells_[a] - kWallCells && v > 0) v = 0;
-                  nd.v[a] = v;
-                }
-              }
-        }
+        for (std::size_t b = bb; b < be; ++b)
+          grid_.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
+            const Real inv_m = Real(1) / nd.m;
+            for (int a = 0; a < 3; ++a) {
+              Real v = nd.v[a] * inv_m + dt * g[a];
+              if (n[a] < kWallCells && v < 0) v = 0;
+              if (n[a] > domain_cells_[a] - kWallCells && v > 0) v = 0;
+              nd.v[a] = v;
+            }
+          });
       },
       opt_.serial);
 }
@@ -141,19 +133,14 @@ void Solver::apply_colliders() {
           box.hi = grid_.node_position(c + Vec3i::Constant(kBlockSize - 1)).array() + dx;
           for (const Collider& col : colliders_) {
             if (!col.bounds().overlaps(box)) continue;
-            auto& nodes = grid_.gblock_nodes[b];
-            for (int i = 0; i < kBlockSize; ++i)
-              for (int j = 0; j < kBlockSize; ++j)
-                for (int k = 0; k < kBlockSize; ++k) {
-                  GridNode& nd = nodes[block_node(i, j, k)];
-                  if (nd.m <= 0) continue;
-                  Vec3 v(nd.v[0], nd.v[1], nd.v[2]);
-                  if (col.apply(grid_.node_position(c + Vec3i(i, j, k)), v)) {
-                    nd.v[0] = v[0];
-                    nd.v[1] = v[1];
-                    nd.v[2] = v[2];
-                  }
-                }
+            grid_.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
+              Vec3 v(nd.v[0], nd.v[1], nd.v[2]);
+              if (col.apply(grid_.node_position(n), v)) {
+                nd.v[0] = v[0];
+                nd.v[1] = v[1];
+                nd.v[2] = v[2];
+              }
+            });
           }
         }
       },

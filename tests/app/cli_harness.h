@@ -8,6 +8,8 @@
 #include <fstream>
 #include <string>
 
+#include "tests/support/temp_dir.h"
+
 namespace shellmpm_test {
 
 struct CmdResult {
@@ -29,22 +31,6 @@ inline CmdResult run_shellmpm(const std::string& args) {
   return r;
 }
 
-/// A fresh directory under the system temp dir, removed at the end of the scope.
-struct TempDir {
-  std::filesystem::path path;
-  explicit TempDir(const std::string& name) {
-    path = std::filesystem::temp_directory_path() /
-           ("shellmpm_test_" + name + "_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(path);
-    std::filesystem::create_directories(path);
-  }
-  ~TempDir() { std::filesystem::remove_all(path); }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-  std::string write(const std::string& name, const std::string& text) const {
-    std::ofstream(file(name)) << text;
-    return file(name);
-  }
-};
 
 inline std::string read_text(const std::string& path) {
   std::ifstream f(path, std::ios::binary);

@@ -16,34 +16,14 @@
 
 #include "io/atomic_file.h"
 #include "io/density_vdb.h"
+#include "tests/support/temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace shellmpm;
+using shellmpm_test::TempDir;
 
 namespace {
 
-/// A fresh directory under the system temp dir, removed with its contents at the end.
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name) {
-    path = fs::temp_directory_path() /
-           ("shellmpm_test_" + name + "_" + std::to_string(static_cast<long>(::getpid())));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string file(const std::string& name) const { return (path / name).string(); }
-  /// Files whose name contains ".tmp." (leftovers of an atomic write).
-  int temp_files() const {
-    int n = 0;
-    for (const auto& e : fs::directory_iterator(path))
-      n += e.path().filename().string().find(".tmp.") != std::string::npos ? 1 : 0;
-    return n;
-  }
-};
 
 std::string slurp(const std::string& path) {
   std::ifstream f(path, std::ios::binary);

@@ -11,30 +11,14 @@
 #include "io/mesh_reader.h"
 #include "io/mesh_sdf.h"
 #include "io/user_error.h"
+#include "tests/support/temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace shellmpm;
+using shellmpm_test::TempDir;
 
 namespace {
 
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name) {
-    path = fs::temp_directory_path() /
-           ("shellmpm_test_" + name + "_" + std::to_string(static_cast<long>(::getpid())));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    const std::string p = (path / name).string();
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-};
 
 /// Unit cube [-0.5, 0.5]^3 as 6 quads (assimp triangulates them), optionally with UVs.
 std::string cube_obj(bool uvs, bool drop_top = false) {

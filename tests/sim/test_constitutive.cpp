@@ -88,12 +88,15 @@ std::vector<Mat3d> test_deformations(std::mt19937& rng) {
     out.push_back(random_rotation(rng) * Vec3d(1.3, 0.8, 0.9).asDiagonal() *
                       random_rotation(rng).transpose() +
                   random_matrix(rng, 0.15));
-  for (int i = 0; i < 2; ++i) out.push_back(random_rotation(rng) * (Mat3d::Identity() + random_matrix(rng, 0.2)));
+  for (int i = 0; i < 2; ++i)
+    out.push_back(random_rotation(rng) * (Mat3d::Identity() + random_matrix(rng, 0.2)));
   for (const Mat3d& F : out) REQUIRE(F.determinant() > 0.2);
   return out;
 }
 
-double stress_scale(const Model& m) { return m.mu + m.lambda; }
+double stress_scale(const Model& m) {
+  return m.mu + m.lambda;
+}
 
 /// Central-difference dpsi/dF with step h.
 Mat3d fd_piola(const Model& m, const Mat3d& F, double plastic, double h) {
@@ -116,8 +119,9 @@ void check_fd(const Model& m, const Mat3d& F, double plastic) {
   const double hs[3] = {1e-3, 1e-4, 1e-5};
   for (int k = 0; k < 3; ++k) err[k] = (fd_piola(m, F, plastic, hs[k]) - P).norm() / scale;
   const double floor = 1e-8;
-  INFO("F =\n" << F << "\nplastic = " << plastic << "\nrelative FD errors: " << err[0] << ", "
-               << err[1] << ", " << err[2]);
+  INFO("F =\n"
+       << F << "\nplastic = " << plastic << "\nrelative FD errors: " << err[0] << ", " << err[1]
+       << ", " << err[2]);
   // The h = 1e-3 error must be a real truncation error, not already at round-off,
   // otherwise the test could not tell a wrong P from a right one.
   CHECK(err[0] < 1e-4);
@@ -126,7 +130,9 @@ void check_fd(const Model& m, const Mat3d& F, double plastic) {
   CHECK(err[2] < 1e-7);
 }
 
-bool same_bits(const Mat3d& a, const Mat3d& b) { return std::memcmp(a.data(), b.data(), sizeof(double) * 9) == 0; }
+bool same_bits(const Mat3d& a, const Mat3d& b) {
+  return std::memcmp(a.data(), b.data(), sizeof(double) * 9) == 0;
+}
 
 /// Hencky strain of F, sorted like svd3's sigma.
 Vec3d hencky(const Mat3d& F) {
@@ -162,8 +168,7 @@ TEST_CASE("constitutive: from_desc parameters", "[constitutive]") {
   CHECK_THROWS_AS(Model::from_desc(bad), shellmpm::InvariantError);
 }
 
-TEST_CASE("constitutive: first Piola matches finite differences of the energy",
-          "[constitutive]") {
+TEST_CASE("constitutive: first Piola matches finite differences of the energy", "[constitutive]") {
   std::mt19937 rng(11);
   const std::vector<Mat3d> Fs = test_deformations(rng);
   for (const Named& nm : all_models()) {
@@ -259,8 +264,9 @@ TEST_CASE("constitutive: Drucker-Prager return mapping", "[constitutive]") {
       const double tr = e.sum();
       return (e.array() - tr / 3).matrix().norm() + k * tr * sand.alpha;
     };
-    DYNAMIC_SECTION("cohesion " << c << ": projection lands on or inside the cone; inside "
-                    "untouched; expansion to the tip") {
+    DYNAMIC_SECTION("cohesion " << c
+                                << ": projection lands on or inside the cone; inside "
+                                   "untouched; expansion to the tip") {
       int n_inside = 0, n_tip = 0, n_cone = 0;
       for (int i = 0; i < 3000; ++i) {
         const Vec3d eps0(0.2 * u(rng) - 0.05, 0.2 * u(rng) - 0.05, 0.2 * u(rng) - 0.05);
@@ -390,11 +396,13 @@ TEMPLATE_TEST_CASE("constitutive: batch calls match per-particle calls", "[const
   const std::size_t n = 37;  // not a multiple of any batch width
   std::vector<Mat3T> F(n);
   for (auto& f : F)
-    f = (random_rotation(rng) * Vec3d(0.9 + 0.2 * u(rng), 0.9 + 0.2 * u(rng), 0.9 + 0.2 * u(rng)).asDiagonal() *
+    f = (random_rotation(rng) *
+         Vec3d(0.9 + 0.2 * u(rng), 0.9 + 0.2 * u(rng), 0.9 + 0.2 * u(rng)).asDiagonal() *
          random_rotation(rng).transpose())
             .cast<T>();
   const double tol = std::is_same<T, float>::value ? 1e-4 : 1e-11;
-  for (const MaterialDesc& d : {desc_fcr(), desc_nh(), desc_sand(0.0), desc_sand(0.01), desc_snow()}) {
+  for (const MaterialDesc& d :
+       {desc_fcr(), desc_nh(), desc_sand(0.0), desc_sand(0.01), desc_snow()}) {
     INFO(d.name);
     const M m = M::from_desc(d);
     std::vector<T> jp(n, m.initial_plastic());

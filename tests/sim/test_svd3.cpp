@@ -138,9 +138,9 @@ template <class T>
 void require_worst(const Worst& w) {
   const double eps = std::numeric_limits<T>::epsilon();
   const double tol = 64 * eps;
-  INFO("worst case family: " << w.where << "; recon " << w.recon << ", orth " << w.orth
-                             << ", det " << w.det << ", sv " << w.sv << ", order " << w.order
-                             << " (tol " << tol << ")");
+  INFO("worst case family: " << w.where << "; recon " << w.recon << ", orth " << w.orth << ", det "
+                             << w.det << ", sv " << w.sv << ", order " << w.order << " (tol " << tol
+                             << ")");
   CHECK(w.nonfinite == 0);
   CHECK(w.sign_errors == 0);
   CHECK(w.recon < tol);
@@ -152,8 +152,8 @@ void require_worst(const Worst& w) {
 
 }  // namespace
 
-TEMPLATE_TEST_CASE("svd3: reconstruction, rotations, ordering, signs, vs JacobiSVD", "[svd]",
-                   float, double) {
+TEMPLATE_TEST_CASE("svd3: reconstruction, rotations, ordering, signs, vs JacobiSVD", "[svd]", float,
+                   double) {
   using T = TestType;
   const auto cases = make_cases(1500, 17u);
   Worst w;
@@ -229,9 +229,8 @@ TEMPLATE_TEST_CASE("polar3: proper rotation, symmetric factor, matches SVD-based
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int i = 0; i < 500; ++i) {
-    Mat3d Ad = random_rotation(rng) * (Mat3d::Identity() + 0.4 * Mat3d(Mat3d::NullaryExpr([&]() {
-                                         return u(rng);
-                                       })));
+    Mat3d Ad = random_rotation(rng) *
+               (Mat3d::Identity() + 0.4 * Mat3d(Mat3d::NullaryExpr([&]() { return u(rng); })));
     if (i % 2) Ad.col(1) = -Ad.col(1);  // half of them inverted
     const M3<T> A = Ad.cast<T>();
     M3<T> R, S;

@@ -1,0 +1,80 @@
+// The README's commands stay true, and every example scene is valid and runs.
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "tests/app/cli_harness.h"
+
+using namespace shellmpm_test;
+
+namespace {
+const std::string kRoot = SHELLMPM_SOURCE_DIR;
+
+std::vector<std::string> fenced_sh_lines(const std::string& md) {
+  std::vector<std::string> out;
+  const std::regex block("```sh\\n([^`]*)```");
+  for (std::sregex_iterator it(md.begin(), md.end(), block), end; it != end; ++it)
+    out.push_back((*it)[1].str());
+  return out;
+}
+
+std::vector<std::string> example_scenes() {
+  std::vector<std::string> s;
+  for (const auto& e : std::filesystem::directory_iterator(kRoot + "/scenes"))
+    if (e.path().extension() == ".yaml") s.push_back(e.path().string());
+  std::sort(s.begin(), s.end());
+  return s;
+}
+
+void run_scene_frames(const std::string& scene, const std::string& frames) {
+  TempDir d("scene_" + std::filesystem::path(scene).stem().string());
+  const CmdResult r = run_shellmpm("run " + scene + " -q --frames " + frames + " -o " + d.file("o"));
+  INFO(scene << "\n" << r.output);
+  REQUIRE(r.code == 0);
+  const auto stats = nlohmann::json::parse(read_text(d.file("o/stats.json")));
+  const auto& last = stats["frames"].back();
+  REQUIRE(std::isfinite(last["kinetic_energy"].get<double>()));
+  REQUIRE(std::isfinite(last["elastic_energy"].get<double>()));
+  REQUIRE(last["particles"].get<double>() > 0);
+  REQUIRE(last["max_speed"].get<double>() < 20.0);  // nothing blew up
+  // Mass is conserved (fill sources) or only grows (emitters).
+  double prev = 0;
+  for (const auto& f : stats["frames"]) {
+    REQUIRE(f["mass"].get<double>() >= prev * (1 - 1e-6));
+    prev = f["mass"].get<double>();
+  }
+}
+}  // namespace
+
+TEST_CASE("README: the test command is the one .ci/run runs, the run command names a scene",
+          "[readme]") {
+  const std::string readme = read_text(kRoot + "/README.md");
+  const auto blocks = fenced_sh_lines(readme);
+  REQUIRE(blocks.size() >= 2);
+  // The first two code blocks are the two commands, one line each.
+  REQUIRE(std::count(blocks[0].begin(), blocks[0].end(), '\n') == 1);
+  REQUIRE(std::count(blocks[1].begin(), blocks[1].end(), '\n') == 1);
+  const std::string ci = read_text(kRoot + "/.ci/run");
+  REQUIRE(ci.find(blocks[1]) != std::string::npos);
+  std::smatch m;
+  REQUIRE(std::regex_search(blocks[0], m, std::regex("shellmpm run (scenes/[a-z_]+\\.yaml)")));
+  REQUIRE(std::filesystem::exists(kRoot + "/" + m[1].str()));
+  // No placeholders left behind.
+  REQUIRE(readme.find("PLACEHOLDER") == std::string::npos);
+}
+
+TEST_CASE("every example scene passes check and runs its first frames", "[scenes]") {
+  const auto scenes = example_scenes();
+  REQUIRE(scenes.size() >= 5);
+  for (const std::string& s : scenes) {
+    const CmdResult c = run_shellmpm("check " + s);
+    INFO(s << "\n" << c.output);
+    REQUIRE(c.code == 0);
+    REQUIRE(c.output.find("stages: bin, p2g, grid, colliders, g2p") != std::string::npos);
+    run_scene_frames(s, "1-3");
+  }
+}
+
+TEST_CASE("every example scene runs to its last frame", "[scenes][slow]") {
+  for (const std::string& s : example_scenes()) run_scene_frames(s, "1-48");
+}
