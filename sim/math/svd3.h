@@ -420,3 +420,5 @@ inline void polar3(const Eigen::Matrix<T, 3, 3>& A, Eigen::Matrix<T, 3, 3>& R,
 }
 
 }  // namespace shellmpm
+
+#undef SHELLMPM_SVD3_INLINE

@@ -13,12 +13,13 @@
 //
 // Models
 // - Fixed corotated (Stomakhin, Howes, Schroeder, Teran 2012, "Energetically consistent
-//   invertible elasticity", SCA; eq. for Psi_FCR):
+//   invertible elasticity", SCA; its fixed-corotated energy and first Piola stress):
 //     psi = mu sum_i (sigma_i - 1)^2 + lambda/2 (J - 1)^2
 //     P   = 2 mu (F - R) + lambda (J - 1) J F^-T,   R = U V^T, J F^-T = cof(F)
 //     tau = 2 mu (F - R) F^T + lambda (J - 1) J I = U diag(2 mu (sigma_i - 1) sigma_i
 //           + lambda (J - 1) J) U^T   (no inverse of F anywhere)
-// - Neo-Hookean (e.g. Bonet & Wood, Nonlinear Continuum Mechanics, eq. 6.27-6.28):
+// - Compressible neo-Hookean (as in Bonet & Wood, "Nonlinear Continuum Mechanics for
+//   Finite Element Analysis", ch. 6, written for F):
 //     psi = mu/2 (tr(F^T F) - 3) - mu log J + lambda/2 (log J)^2
 //     P   = mu (F - F^-T) + lambda log J F^-T
 //     tau = mu (F F^T - I) + lambda log J I          (no SVD, no inverse)
@@ -28,8 +29,8 @@
 //   energy and P are a regularization and no longer each other's derivative.
 // - Sand: Drucker-Prager plasticity on the Hencky strain (Klar, Gast, Pradhana, Fu,
 //   Schroeder, Jiang, Teran 2016, "Drucker-Prager elastoplasticity for sand animation",
-//   SIGGRAPH; St. Venant-Kirchhoff energy in Hencky strain, sec. 6, return mapping
-//   sec. 7):
+//   SIGGRAPH: St. Venant-Kirchhoff energy in the Hencky strain; return mapping of its
+//   sec. 7, cases I-III):
 //     eps = log(Sigma), psi = mu tr(eps^2) + lambda/2 tr(eps)^2
 //     tau = U diag(2 mu eps_i + lambda tr(eps)) U^T,   P = tau F^-T = U diag(tau_i /
 //           sigma_i) V^T
@@ -43,10 +44,12 @@
 //   then F = U diag(exp(eps)) V^T. The plastic scalar is not used (stays 0): the volume
 //   correction of Tampubolon et al. 2017 is not applied. For |sigma_i| below
 //   kHenckyMinSigma (10^4-fold compression, or an inverted F where |sigma| is used) the
-//   strain is clamped at log(kHenckyMinSigma); energy and stress stay finite there.
+//   strain is clamped at log(kHenckyMinSigma); energy and stress stay finite there. A
+//   projected inverted F comes out non-inverted (exp(eps) > 0), as in common MPM codes.
 // - Snow (Stomakhin, Schroeder, Chai, Teran, Selle 2013, "A material point method for
-//   snow simulation", SIGGRAPH; sec. 3 "constitutive model" eqs. for psi, mu(F_P),
-//   lambda(F_P), and sec. "update deformation gradient"):
+//   snow simulation", SIGGRAPH: energy eq. (1) and hardening eq. (2) of its constitutive
+//   model, and the clamp of the singular values of F_E with F_P absorbing the rest in its
+//   deformation-gradient update):
 //   F holds the elastic part F_E; plastic = J_P, the plastic volume ratio (1 at rest).
 //     psi = mu(J_P) sum (sigma_i - 1)^2 + lambda(J_P)/2 (J_E - 1)^2   (fixed corotated)
 //     mu(J_P) = mu0 exp(xi (1 - J_P)),  lambda(J_P) = lambda0 exp(xi (1 - J_P))
