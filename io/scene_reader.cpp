@@ -1089,6 +1089,11 @@ Scene build_scene(const DocNode& root, const std::string& path) {
     }
     src.material = static_cast<int>(found - scene.materials.begin());
     src.shape = read_shape(*r.block("shape"), r.path_of("shape"), true, path);
+    {
+      const Origin& o = r.origin_of("shape");
+      src.shape.where = (o.line > 0 ? o.where + ":" + std::to_string(o.line) : o.where) + ": " +
+                        r.path_of("shape");
+    }
     src.particles_per_cell = r.number("particles_per_cell");
     src.velocity = r.vec3("velocity");
     src.seed = static_cast<unsigned>(r.integer("seed"));

@@ -69,6 +69,24 @@ Vec3d Collider::velocity(const Vec3d& x) const {
   return (x - start_.apply(end_.apply_inverse(x))) / dt_;
 }
 
+double Collider::max_speed(double t) const {
+  if (!animated()) return 0.0;
+  const double h = 1e-4;
+  const RigidPose a = keyframe_pose(desc_.keyframes, t), b = keyframe_pose(desc_.keyframes, t + h);
+  // Rigid velocity is affine in position, so its largest norm over a box is at a corner.
+  double vmax = 0;
+  auto at = [&](const Vec3d& xl) { vmax = std::max(vmax, (b.apply(xl) - a.apply(xl)).norm() / h); };
+  if (local_bounds_.infinite) {
+    at(desc_.shape.point);
+  } else {
+    for (int c = 0; c < 8; ++c)
+      at(Vec3d((c & 4) ? local_bounds_.hi.x() : local_bounds_.lo.x(),
+               (c & 2) ? local_bounds_.hi.y() : local_bounds_.lo.y(),
+               (c & 1) ? local_bounds_.hi.z() : local_bounds_.lo.z()));
+  }
+  return vmax;
+}
+
 bool Collider::apply(const Vec3d& x, Vec3& v) const {
   const Vec3d xl = end_.apply_inverse(x);
   if (shape_phi(desc_.shape, xl) > 0) return false;

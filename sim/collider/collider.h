@@ -35,6 +35,9 @@ class Collider {
   /// Applies the boundary condition to a node velocity at world x; true if in contact.
   bool apply(const Vec3d& x, Vec3& v) const;
   bool animated() const { return desc_.keyframes.size() > 1; }
+  /// Largest speed of the collider's points at time t [m/s] (for the CFL bound); planes
+  /// count their reference point only.
+  double max_speed(double t) const;
   const ColliderDesc& desc() const { return desc_; }
 
  private:

@@ -64,6 +64,8 @@ struct ShapeDesc {
   /// mesh: where `path` was given, for messages, as "file:line: key" (UserError's prefix),
   /// e.g. "shot.yaml:14: colliders[0].shape.path"; "--set K=V: key" for an override.
   std::string mesh_where;
+  /// where the shape was given ("file:line: key"), for messages; may be empty
+  std::string where;
   double mesh_scale = 1.0;           ///< mesh: uniform scale applied on load
   Vec3d mesh_translate{0, 0, 0};     ///< mesh: translation applied on load
   /// mesh: signed distance (negative inside), built by io/ from the mesh file.

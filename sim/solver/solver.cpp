@@ -217,6 +217,7 @@ double Solver::stable_dt() const {
     vmax = *std::max_element(vm.begin(), vm.end());
     cmax = *std::max_element(cm.begin(), cm.end());
   }
+  for (const Collider& c : colliders_) vmax = std::max(vmax, c.max_speed(time_));
   if (vmax > 0) dt = std::min(dt, s.cfl * s.dx / vmax);
   if (cmax > 0) dt = std::min(dt, s.cfl * s.dx / cmax);
   return dt;

@@ -101,6 +101,10 @@ TEST_CASE("CLI: bad input gives file, line, key and exit code 2", "[cli]") {
                    "{type: mesh, path: broken.obj}");
     expect_user_error(run_shellmpm("run " + s), {"broken.obj"});
   }
+  SECTION("source outside the domain") {
+    const std::string s = scene_with(d, kGood, "max: [0.1, 0.5, 0.1]", "max: [0.1, 1.5, 0.1]");
+    expect_user_error(run_shellmpm("run " + s), {"scene.yaml:9", "sources[0].shape", "outside shot.domain"});
+  }
   SECTION("--set with an unknown key") {
     const std::string s = scene_with(d, kGood);
     expect_user_error(run_shellmpm("run " + s + " --set shot.dxx=1"), {"--set shot.dxx=1", "dxx"});

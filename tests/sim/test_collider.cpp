@@ -111,6 +111,14 @@ TEST_CASE("keyframed colliders move and carry their velocity", "[collider]") {
   const Vec3d omega(0, M_PI / 4, 0);  // 90 degrees over 2 s
   const Vec3d expect = Vec3d(1, 0, 0) + omega.cross(x - mid.t);
   REQUIRE((c.velocity(x) - expect).norm() < 1e-3);
+  // The fastest point is a corner of the box: |translation rate + omega x r| there.
+  double vmax = 0;
+  for (int k = 0; k < 8; ++k) {
+    const Vec3d corner((k & 4) ? 1 : -1, (k & 2) ? 1 : -1, (k & 1) ? 1 : -1);
+    vmax = std::max(vmax, (Vec3d(1, 0, 0) + omega.cross(mid.R * corner)).norm());
+  }
+  REQUIRE(c.max_speed(1.0) == Approx(vmax).epsilon(1e-3));
+  REQUIRE(Collider(plane_collider(BoundaryKind::Slip, 0)).max_speed(1.0) == 0);
   Vec3 v(5, 5, 5);
   REQUIRE(c.apply(x, v));
   REQUIRE((v.cast<double>() - expect).norm() < 1e-3);
