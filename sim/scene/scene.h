@@ -8,6 +8,7 @@
 
 #include "sim/core/types.h"
 #include "sim/scene/sdf_grid.h"
+#include "sim/scene/shell_mesh.h"
 
 namespace shellmpm {
 
@@ -103,6 +104,76 @@ struct ColliderDesc {
   std::vector<Keyframe> keyframes;     ///< empty = static; linear/slerp between keys
 };
 
+/// A Kirchhoff-Love shell material (plane-stress Hencky laminate, METHOD.md).
+struct ShellMaterialDesc {
+  std::string name;
+  double youngs_modulus = 1e6;  ///< E [Pa]
+  double poisson_ratio = 0.3;   ///< nu, in [0, 0.5)
+  double density = 1000.0;      ///< [kg/m^3]
+  double thickness = 1e-3;      ///< t [m]
+  double yield_stress = 0.0;    ///< von Mises yield [Pa]; 0 = no denting (no plasticity stage)
+  double damping = 0.0;         ///< mass-proportional damping rate [1/s]
+  double stiffness_damping = 0.0;  ///< Rayleigh stiffness-proportional damping [s]
+  int quadrature_inplane = 3;   ///< in-plane points per triangle: 1, 3, 6 or 7
+  int quadrature_thickness = 3; ///< Gauss points through the thickness: 1 to 5
+};
+
+/// A rigid keyframed motion shared by pins (and colliders).
+using Motion = std::vector<Keyframe>;
+
+/// Pinned control points of a shell: chosen by index, by region or by named group.
+struct PinDesc {
+  std::vector<int> indices;              ///< control point indices
+  bool has_box = false;                  ///< select points inside [box_min, box_max] (rest pose)
+  Vec3d box_min{0, 0, 0}, box_max{0, 0, 0};
+  std::string group;                     ///< a named vertex group of the mesh file
+  bool components[3] = {true, true, true};  ///< which of x, y, z are held
+  Motion keyframes;                      ///< empty: fixed at the rest position; else moves rigidly
+};
+
+/// A point load on one control point [N].
+struct PointLoadDesc {
+  int index = 0;
+  Vec3d force{0, 0, 0};
+};
+
+/// A shell object: control mesh from a file or made procedurally.
+struct ShellDesc {
+  std::string name;
+  int material = 0;  ///< index into Scene::shell_materials
+  enum class Kind { Mesh, Sheet, Cylinder, Sphere } kind = Kind::Sheet;
+  // mesh
+  std::string mesh_path;
+  std::string mesh_where;  ///< "file:line: key" for messages
+  std::shared_ptr<const ShellMesh> mesh;  ///< filled by io/ (load_scene_assets) for Kind::Mesh
+  // sheet: a rectangle in the local XZ plane (normal +Y), size along X and Z
+  double size[2] = {1.0, 1.0};
+  int resolution[2] = {10, 10};  ///< quads along X and Z (two triangles each)
+  // cylinder patch: axis along local Y, angle in degrees around it (360 = closed tube)
+  double radius = 0.5;
+  double height = 1.0;
+  double angle_deg = 360.0;
+  // sphere: icosahedron subdivided `subdivisions` times
+  int subdivisions = 2;
+  // placement (applied to the rest mesh): x' = R(rotate) * (scale * x) + translate
+  double scale = 1.0;
+  Vec3d rotate_deg{0, 0, 0};
+  Vec3d translate{0, 0, 0};
+  Vec3d velocity{0, 0, 0};  ///< initial velocity [m/s]
+  std::vector<PinDesc> pins;
+  double pressure = 0.0;    ///< surface load along the normal [Pa] (positive pushes along +normal)
+  std::vector<PointLoadDesc> point_loads;
+  int output_refine = 0;    ///< limit-surface refinement levels of the written mesh (0..4)
+  bool write_mesh = true;
+};
+
+/// Pre-roll: settle shells to static equilibrium before frame 1 (damped dynamic relaxation).
+struct PrerollSettings {
+  bool enabled = false;
+  double tolerance = 1e-4;  ///< stop when max |residual force| / max |gravity force| < tolerance
+  int max_steps = 200000;   ///< give up (error) after this many steps
+};
+
 /// What to write.
 struct OutputSettings {
   std::string directory = "out";
@@ -115,6 +186,8 @@ struct OutputSettings {
   double voxel_size = 0.0;      ///< 0 = the grid spacing dx
   bool particles = false;       ///< particle cache (positions, velocities) per frame
   int checkpoint_every = 0;     ///< frames between checkpoints; 0 = none
+  std::string shell_pattern = "{name}.####.ply";  ///< per shell; {name} = the shell's name
+  std::string shell_format = "ply";  ///< ply (binary) | obj | glb
 };
 
 /// A whole shot.
@@ -124,6 +197,9 @@ struct Scene {
   std::vector<MaterialDesc> materials;
   std::vector<SourceDesc> sources;
   std::vector<ColliderDesc> colliders;
+  std::vector<ShellMaterialDesc> shell_materials;
+  std::vector<ShellDesc> shells;
+  PrerollSettings preroll;
   OutputSettings output;
 };
 
