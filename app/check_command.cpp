@@ -30,6 +30,14 @@ int check_command(const CommonArgs& a) {
     for (double t = sm.emit_t0(); t < sm.emit_t1(); t += step)
       sm.emit(t, std::min(step, sm.emit_t1() - t), [&](const Vec3d&) { ++emitted; });
   }
+  for (const auto& sh : solver.shells()) {
+    const ShellMaterialDesc& m = scene.shell_materials[sh->desc().material];
+    std::printf("shell %s: %zu control points, %zu output vertices, %d x %d quadrature points per "
+                "triangle, stable step %.3g s%s\n",
+                sh->name().c_str(), sh->size(), sh->limit_mesh().num_vertices(),
+                m.quadrature_inplane, m.quadrature_thickness, sh->stable_dt(s.cfl),
+                m.yield_stress > 0 ? ", denting" : "");
+  }
   const std::size_t n0 = solver.particles().size();
   std::printf("particles: %zu at start, about %zu more emitted\n", n0, emitted);
   // Bin once to count grid blocks (no simulation).

@@ -7,6 +7,7 @@
 #include "io/checkpoint.h"
 #include "io/mesh_sdf.h"
 #include "io/scene_reader.h"
+#include "io/shell_assets.h"
 #include "io/user_error.h"
 #include "sim/solver/source_sampler.h"
 
@@ -78,6 +79,7 @@ LoadedScene load_scene_for_cli(const CommonArgs& a, const std::string& frames,
   if (!output.empty()) ls.scene.output.directory = output;
   if (a.threads >= 0) shot.threads = a.threads;
   load_scene_assets(ls.scene);
+  load_shell_meshes(ls.scene);
   check_sources_inside_domain(ls.scene);
   return ls;
 }

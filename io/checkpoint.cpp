@@ -7,6 +7,7 @@
 
 #include "io/atomic_file.h"
 #include "io/user_error.h"
+#include "sim/solver/solver.h"
 
 namespace shellmpm {
 namespace {
@@ -81,6 +82,15 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
     put_vec(f, p.plastic);
     put<std::uint64_t>(f, c.stats_json.size());
     f.write(c.stats_json.data(), static_cast<std::streamsize>(c.stats_json.size()));
+    put<std::uint64_t>(f, c.shells.size());
+    put(f, c.shell_plastic_work);
+    for (const auto& sh : c.shells) {
+      put<std::uint64_t>(f, sh.x.size());
+      put_vec(f, sh.x);
+      put_vec(f, sh.v);
+      put<std::uint64_t>(f, sh.plastic.size());
+      put_vec(f, sh.plastic);
+    }
     f.write(kMagic, 8);
     if (!f) throw std::system_error(errno, std::generic_category(), "writing " + tmp);
   });
@@ -118,9 +128,46 @@ Checkpoint read_checkpoint(const std::string& path) {
   if (len > r.file_size) r.fail("statistics longer than the file");
   c.stats_json.resize(len);
   r.f.read(c.stats_json.data(), static_cast<std::streamsize>(len));
+  const auto nshells = r.get<std::uint64_t>();
+  if (nshells > 1000000) r.fail("bad shell count");
+  c.shell_plastic_work = r.get<double>();
+  c.shells.resize(nshells);
+  for (auto& sh : c.shells) {
+    const auto np = r.get<std::uint64_t>();
+    r.get_vec(sh.x, np);
+    r.get_vec(sh.v, np);
+    const auto npl = r.get<std::uint64_t>();
+    r.get_vec(sh.plastic, npl);
+  }
   r.f.read(magic, 8);
   if (!r.f || std::string(magic, 8) != std::string(kMagic, 8)) r.fail("missing end marker");
   return c;
+}
+
+void save_shells(const Solver& solver, Checkpoint& c) {
+  c.shells.clear();
+  for (const auto& sh : solver.shells()) {
+    Checkpoint::ShellState st;
+    st.x = sh->x;
+    st.v = sh->v;
+    st.plastic = sh->kl().plastic_state();
+    c.shells.push_back(std::move(st));
+  }
+  c.shell_plastic_work = solver.shell_plastic_work();
+}
+
+void restore_shells(Solver& solver, const Checkpoint& c) {
+  auto& shells = solver.shells();
+  if (c.shells.size() != shells.size())
+    throw UserError("checkpoint", 0, "", "shell count differs from the scene");
+  for (std::size_t i = 0; i < shells.size(); ++i) {
+    if (c.shells[i].x.size() != shells[i]->size())
+      throw UserError("checkpoint", 0, "", "shell '" + shells[i]->name() + "' has another size");
+    shells[i]->x = c.shells[i].x;
+    shells[i]->v = c.shells[i].v;
+    shells[i]->kl().set_plastic_state(c.shells[i].plastic);
+  }
+  solver.set_shell_plastic_work(c.shell_plastic_work);
 }
 
 std::string latest_checkpoint(const std::string& dir, int max_frame) {

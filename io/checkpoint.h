@@ -14,7 +14,19 @@ struct Checkpoint {
   double time = 0;                      ///< simulation time [s]
   ParticleSet particles;
   std::string stats_json;               ///< statistics of the frames written so far
+  /// Per shell: control point positions, velocities and the denting plastic state.
+  struct ShellState {
+    std::vector<Vec3> x, v;
+    std::vector<Real> plastic;
+  };
+  std::vector<ShellState> shells;
+  double shell_plastic_work = 0;
 };
+
+class Solver;
+/// Copies the shells' state from the solver into the checkpoint, and back.
+void save_shells(const Solver& solver, Checkpoint& c);
+void restore_shells(Solver& solver, const Checkpoint& c);
 
 /// Writes atomically; the file records the scalar size so a float build refuses a
 /// double checkpoint.

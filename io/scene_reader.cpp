@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <climits>
@@ -99,15 +100,33 @@ class Spec {
 
 using T = KeyType;
 
+/// The keys of one keyframe list item under `prefix` ("colliders[].keyframes[]").
+std::vector<KeySpec> keyframe_specs(const std::string& prefix) {
+  return {
+      Spec(prefix + ".time", T::Number).optional("give time or frame").unit("s").ge(0),
+      Spec(prefix + ".frame", T::Int).optional("give time or frame").ge(1),
+      Spec(prefix + ".translate", T::Vec3).def("[0, 0, 0]").unit("m"),
+      Spec(prefix + ".rotate", T::Vec3).def("[0, 0, 0]").unit("deg"),
+  };
+}
+
 std::vector<KeySpec> build_schema() {
   const std::vector<std::string> kShapeTypes = {"plane", "box", "sphere", "cylinder", "mesh"};
-  return {
+  std::vector<KeySpec> schema;
+  auto add = [&schema](std::vector<KeySpec> specs) {
+    schema.insert(schema.end(), specs.begin(), specs.end());
+  };
+  const std::string kPinSelector = "give exactly one of indices, box, group";
+  add({
       // top level
       Spec("version", T::Int).required().ge(1).le(1),
       Spec("shot", T::Map).required(),
       Spec("materials", T::List).def("[]"),
       Spec("sources", T::List).def("[]"),
       Spec("colliders", T::List).def("[]"),
+      Spec("shell_materials", T::List).def("[]"),
+      Spec("shells", T::List).def("[]"),
+      Spec("preroll", T::Map).def("{}"),
       Spec("output", T::Map).def("{}"),
       // shot
       Spec("shot.frames", T::FrameRange).def("[1, 48]").ge(1),
@@ -170,13 +189,90 @@ std::vector<KeySpec> build_schema() {
       Spec("colliders[].boundary", T::Enum).def("separate").choices({"sticky", "slip", "separate"}),
       Spec("colliders[].friction", T::Number).def("0").ge(0),
       Spec("colliders[].keyframes", T::List).def("[]").rule("times strictly increase"),
-      Spec("colliders[].keyframes[].time", T::Number)
-          .optional("give time or frame")
-          .unit("s")
-          .ge(0),
-      Spec("colliders[].keyframes[].frame", T::Int).optional("give time or frame").ge(1),
-      Spec("colliders[].keyframes[].translate", T::Vec3).def("[0, 0, 0]").unit("m"),
-      Spec("colliders[].keyframes[].rotate", T::Vec3).def("[0, 0, 0]").unit("deg"),
+  });
+  add(keyframe_specs("colliders[].keyframes[]"));
+  add({
+      // shell materials
+      Spec("shell_materials[].name", T::String).required().nonempty().rule("unique"),
+      Spec("shell_materials[].youngs_modulus", T::Number).def("1e6").unit("Pa").gt(0),
+      Spec("shell_materials[].poisson_ratio", T::Number).def("0.3").ge(0).lt(0.5),
+      Spec("shell_materials[].density", T::Number).def("1000").unit("kg/m^3").gt(0),
+      Spec("shell_materials[].thickness", T::Number).def("0.001").unit("m").gt(0),
+      Spec("shell_materials[].yield_stress", T::Number).def("0").unit("Pa").ge(0),
+      Spec("shell_materials[].damping", T::Number).def("0").unit("1/s").ge(0),
+      Spec("shell_materials[].stiffness_damping", T::Number).def("0").unit("s").ge(0),
+      Spec("shell_materials[].quadrature_inplane", T::Int).def("3").rule("one of: 1, 3, 6, 7"),
+      Spec("shell_materials[].quadrature_thickness", T::Int).def("3").ge(1).le(5),
+      // shells
+      Spec("shells[].name", T::String)
+          .optional("`shell<i>` (i = list index)")
+          .nonempty()
+          .rule("unique; letters, digits, `_`, `-` only"),
+      Spec("shells[].material", T::String).required().rule("a name in shell_materials"),
+      Spec("shells[].geometry", T::Map).required(),
+      Spec("shells[].scale", T::Number).def("1").gt(0),
+      Spec("shells[].rotate", T::Vec3).def("[0, 0, 0]").unit("deg"),
+      Spec("shells[].translate", T::Vec3).def("[0, 0, 0]").unit("m"),
+      Spec("shells[].velocity", T::Vec3).def("[0, 0, 0]").unit("m/s"),
+      Spec("shells[].pressure", T::Number).def("0").unit("Pa"),
+      Spec("shells[].point_loads", T::List).def("[]"),
+      Spec("shells[].point_loads[].index", T::Int).required().ge(0).rule("< number of vertices"),
+      Spec("shells[].point_loads[].force", T::Vec3).required().unit("N"),
+      Spec("shells[].pins", T::List).def("[]"),
+      Spec("shells[].pins[].indices", T::IntList)
+          .optional(kPinSelector)
+          .ge(0)
+          .rule("non-empty; each < number of vertices"),
+      Spec("shells[].pins[].box", T::Map).optional(kPinSelector),
+      Spec("shells[].pins[].box.min", T::Vec3).required().unit("m"),
+      Spec("shells[].pins[].box.max", T::Vec3).required().unit("m").rule(">= min on every axis"),
+      Spec("shells[].pins[].group", T::String)
+          .optional(kPinSelector)
+          .nonempty()
+          .rule("geometry type mesh only"),
+      Spec("shells[].pins[].components", T::Bool3)
+          .def("[true, true, true]")
+          .rule("at least one true"),
+      Spec("shells[].pins[].keyframes", T::List).def("[]").rule("times strictly increase"),
+      Spec("shells[].pins[].release", T::Number).optional("never").unit("s").ge(0),
+  });
+  add(keyframe_specs("shells[].pins[].keyframes[]"));
+  add({
+      Spec("shells[].output_refine", T::Int).def("0").ge(0).le(4),
+      Spec("shells[].write_mesh", T::Bool).def("true"),
+      // shell geometry (the value of shells[].geometry)
+      Spec("shells[].geometry.type", T::Enum)
+          .required()
+          .choices({"sheet", "cylinder", "sphere", "mesh"}),
+      Spec("shells[].geometry.size", T::Vec2).def("[1, 1]").unit("m").gt(0).only_for({"sheet"}),
+      Spec("shells[].geometry.resolution", T::Int2)
+          .def("[10, 10]")
+          .ge(1)
+          .le(2000)
+          .only_for({"sheet", "cylinder"})
+          .rule("closed cylinder: first >= 3"),
+      Spec("shells[].geometry.radius", T::Number)
+          .def("0.5")
+          .unit("m")
+          .gt(0)
+          .only_for({"cylinder", "sphere"}),
+      Spec("shells[].geometry.height", T::Number).def("1").unit("m").gt(0).only_for({"cylinder"}),
+      Spec("shells[].geometry.angle", T::Number)
+          .def("360")
+          .unit("deg")
+          .gt(0)
+          .le(360)
+          .only_for({"cylinder"}),
+      Spec("shells[].geometry.subdivisions", T::Int).def("2").ge(0).le(7).only_for({"sphere"}),
+      Spec("shells[].geometry.path", T::String)
+          .required()
+          .nonempty()
+          .only_for({"mesh"})
+          .rule("readable file; relative to the scene file"),
+      // pre-roll
+      Spec("preroll.enabled", T::Bool).def("false"),
+      Spec("preroll.tolerance", T::Number).def("1e-4").gt(0),
+      Spec("preroll.max_steps", T::Int).def("200000").ge(1),
       // output
       Spec("output.directory", T::String).def("out").nonempty(),
       Spec("output.density", T::Bool).def("true"),
@@ -192,6 +288,10 @@ std::vector<KeySpec> build_schema() {
           .rule("exactly one run of `#`"),
       Spec("output.stats", T::String).def("stats.json").nonempty(),
       Spec("output.checkpoint_every", T::Int).def("0").ge(0),
+      Spec("output.shell_pattern", T::String)
+          .def("\"{name}.####.ply\"")
+          .rule("exactly one run of `#`; contains `{name}` when there are several shells"),
+      Spec("output.shell_format", T::Enum).def("ply").choices({"ply", "obj", "glb"}),
       // shapes (the value of sources[].shape and colliders[].shape)
       Spec("shape.type", T::Enum).required().choices(kShapeTypes),
       Spec("shape.min", T::Vec3).required().unit("m").only_for({"box"}),
@@ -209,7 +309,8 @@ std::vector<KeySpec> build_schema() {
           .rule("readable file; relative to the scene file"),
       Spec("shape.scale", T::Number).def("1").gt(0).only_for({"mesh"}),
       Spec("shape.translate", T::Vec3).def("[0, 0, 0]").unit("m").only_for({"mesh"}),
-  };
+  });
+  return schema;
 }
 
 const std::unordered_map<std::string, const KeySpec*>& schema_index() {
@@ -689,6 +790,80 @@ class MapReader {
     return {f[0], f[1]};
   }
 
+  /// A list of exactly 2 numbers, each within the bounds.
+  std::array<double, 2> vec2(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Vec2);
+    const DocNode& v = value(key, s);
+    if (v.kind != DocNode::Kind::List || v.items.size() != 2) {
+      fail(v.origin, path_of(key), "expected a list of 2 numbers, got " + describe(v));
+    }
+    std::array<double, 2> x{};
+    for (int i = 0; i < 2; ++i) {
+      const std::string item_key = path_of(key) + "[" + std::to_string(i) + "]";
+      x[i] = to_number(v.items[i], item_key);
+      if (!in_bounds(s, x[i])) {
+        fail(v.items[i].origin, item_key, bounds_requirement(s) + ", got " + v.items[i].text);
+      }
+    }
+    return x;
+  }
+
+  /// A list of exactly 2 integers, each within the bounds.
+  std::array<int, 2> int2(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Int2);
+    const DocNode& v = value(key, s);
+    if (v.kind != DocNode::Kind::List || v.items.size() != 2) {
+      fail(v.origin, path_of(key), "expected a list of 2 integers, got " + describe(v));
+    }
+    std::array<int, 2> x{};
+    for (int i = 0; i < 2; ++i) {
+      x[i] = bounded_int(s, v.items[i], path_of(key) + "[" + std::to_string(i) + "]");
+    }
+    return x;
+  }
+
+  /// A non-empty list of integers, each within the bounds.
+  std::vector<int> int_list(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::IntList);
+    const DocNode& v = value(key, s);
+    if (v.kind != DocNode::Kind::List) {
+      fail(v.origin, path_of(key), "expected a list of integers, got " + describe(v));
+    }
+    if (v.items.empty()) fail(v.origin, path_of(key), "must not be empty");
+    std::vector<int> x;
+    for (std::size_t i = 0; i < v.items.size(); ++i) {
+      x.push_back(bounded_int(s, v.items[i], path_of(key) + "[" + std::to_string(i) + "]"));
+    }
+    return x;
+  }
+
+  /// A list of exactly 3 booleans.
+  std::array<bool, 3> bool3(const std::string& key) {
+    const KeySpec& s = spec(key, KeyType::Bool3);
+    const DocNode& v = value(key, s);
+    if (v.kind != DocNode::Kind::List || v.items.size() != 3) {
+      fail(v.origin, path_of(key), "expected a list of 3 booleans [x, y, z], got " + describe(v));
+    }
+    std::array<bool, 3> x{};
+    for (int i = 0; i < 3; ++i) {
+      const DocNode& item = v.items[i];
+      const bool ok = item.kind == DocNode::Kind::Scalar && item.plain &&
+                      (item.text == "true" || item.text == "false");
+      if (!ok) {
+        fail(item.origin, path_of(key) + "[" + std::to_string(i) + "]",
+             "expected true or false, got " + describe(item));
+      }
+      x[i] = item.text == "true";
+    }
+    return x;
+  }
+
+  /// The value node of a present key (not marked read), or nullptr.
+  const DocNode* present(const std::string& key) const {
+    const int i = index_of(key);
+    return i >= 0 ? &node_.entries[i].value : nullptr;
+  }
+
   /// A Map, List or Shape value: the given one, the default, or nullptr when an Optional key
   /// is absent. Checks the node kind.
   const DocNode* block(const std::string& key) {
@@ -719,6 +894,16 @@ class MapReader {
     for (std::size_t i = 0; i < node_.entries.size(); ++i)
       if (node_.entries[i].key == key) return static_cast<int>(i);
     return -1;
+  }
+
+  static int bounded_int(const KeySpec& s, const DocNode& item, const std::string& item_key) {
+    const long long x = to_integer(item, item_key);
+    if (!in_bounds(s, static_cast<double>(x))) {
+      fail(item.origin, item_key, bounds_requirement(s) + ", got " + item.text);
+    }
+    if (x > INT_MAX || x < INT_MIN)
+      fail(item.origin, item_key, "integer " + item.text + " is too large");
+    return static_cast<int>(x);
   }
 
   const KeySpec& spec(const std::string& key, KeyType t1, KeyType t2 = KeyType::Int,
@@ -920,6 +1105,83 @@ void require_one_hash_run(const std::string& pattern, const Origin& o, const std
   }
 }
 
+/// "file:line: key" (or "--set K=V: key"), the prefix of a UserError, for fields that io/
+/// reports problems at after the scene is read.
+std::string where_text(const Origin& o, const std::string& key) {
+  return (o.line > 0 ? o.where + ":" + std::to_string(o.line) : o.where) + ": " + key;
+}
+
+/// A UserError at a where_text() string ("file:line: key", "--set K=V: key"), with `suffix`
+/// appended to the key; at `fallback_file` / `fallback_key` when `where` is empty.
+UserError error_at_where(const std::string& where, const std::string& fallback_file,
+                         const std::string& fallback_key, const std::string& suffix,
+                         const std::string& message) {
+  if (where.empty()) return UserError(fallback_file, 0, fallback_key + suffix, message);
+  // Keys never hold ": ", so the last one ends the location. A "--set" location has no line.
+  const std::size_t sep = where.rfind(": ");
+  std::string head = sep == std::string::npos ? where : where.substr(0, sep);
+  const std::string key = sep == std::string::npos ? fallback_key : where.substr(sep + 2);
+  int line = 0;
+  const std::size_t colon = head.rfind(':');
+  if (head.compare(0, 6, "--set ") != 0 && colon != std::string::npos && colon + 1 < head.size() &&
+      head.size() - colon - 1 < 10 &&
+      std::all_of(head.begin() + static_cast<std::ptrdiff_t>(colon) + 1, head.end(), is_digit)) {
+    line = std::stoi(head.substr(colon + 1));
+    head.erase(colon);
+  }
+  return UserError(head, line, key + suffix, message);
+}
+
+/// Reads a mesh file path, resolved relative to the scene file; the file must be readable.
+/// Returns the resolved path and where it was given ("file:line: key").
+std::pair<std::string, std::string> read_mesh_path(MapReader& r, const std::string& key,
+                                                   const std::string& scene_path) {
+  const std::string raw = r.string(key);
+  fs::path p(raw);
+  if (p.is_relative()) p = fs::path(scene_path).parent_path() / p;
+  p = p.lexically_normal();
+  const Origin& o = r.origin_of(key);
+  std::error_code ec;
+  const fs::file_status st = fs::status(p, ec);
+  if (!fs::exists(st)) fail(o, r.path_of(key), "mesh file not found: " + p.string());
+  if (!fs::is_regular_file(st)) fail(o, r.path_of(key), "not a regular file: " + p.string());
+  if (!std::ifstream(p, std::ios::binary)) {
+    fail(o, r.path_of(key), "cannot read mesh file " + p.string() + ": " + std::strerror(errno));
+  }
+  return {p.string(), where_text(o, r.path_of(key))};
+}
+
+/// Reads the keyframe list at `key` (items with the schema keys under `item_prefix`); frame N
+/// is at time (N - 1) / fps. Times must strictly increase.
+std::vector<Keyframe> read_keyframes(MapReader& r, const std::string& key,
+                                     const std::string& item_prefix, double fps) {
+  std::vector<Keyframe> out;
+  const DocNode& keys = *r.block(key);
+  for (std::size_t k = 0; k < keys.items.size(); ++k) {
+    const std::string kp = r.path_of(key) + "[" + std::to_string(k) + "]";
+    MapReader kr(keys.items[k], item_prefix, kp, false);
+    Keyframe kf;
+    const bool has_time = kr.has("time"), has_frame = kr.has("frame");
+    if (has_time && has_frame) {
+      fail(kr.key_origin_of("frame"), kp, "give either time or frame, not both");
+    }
+    if (!has_time && !has_frame) fail(kr.origin(), kp, "needs a time (seconds) or a frame");
+    // Frame N is the state written as frame N, at t = (N - 1) / fps (frame 1 = start).
+    kf.time = has_time ? kr.number("time") : (kr.int32("frame") - 1) / fps;
+    const std::string tkey = has_time ? "time" : "frame";
+    if (!out.empty() && !(kf.time > out.back().time)) {
+      fail(kr.origin_of(tkey), kr.path_of(tkey),
+           "keyframe times must strictly increase: " + fmt_num(kf.time) + " s is not after " +
+               fmt_num(out.back().time) + " s (keyframe " + std::to_string(k - 1) + ")");
+    }
+    kf.translate = kr.vec3("translate");
+    kf.rotate_deg = kr.vec3("rotate");
+    kr.finish();
+    out.push_back(kf);
+  }
+  return out;
+}
+
 void read_shot(const DocNode& node, ShotSettings& shot) {
   MapReader r(node, "shot", "shot", false);
   std::tie(shot.frame_start, shot.frame_end) = r.frames("frames");
@@ -1017,27 +1279,226 @@ ShapeDesc read_shape(const DocNode& node, const std::string& path, bool for_sour
   } else {
     SHELLMPM_CHECK(type == "mesh", "shape type " << type);
     s.kind = ShapeDesc::Kind::Mesh;
-    const std::string raw = r.string("path");
-    fs::path p(raw);
-    if (p.is_relative()) p = fs::path(scene_path).parent_path() / p;
-    p = p.lexically_normal();
-    const Origin& o = r.origin_of("path");
-    std::error_code ec;
-    const fs::file_status st = fs::status(p, ec);
-    if (!fs::exists(st)) fail(o, r.path_of("path"), "mesh file not found: " + p.string());
-    if (!fs::is_regular_file(st)) fail(o, r.path_of("path"), "not a regular file: " + p.string());
-    if (!std::ifstream(p, std::ios::binary)) {
-      fail(o, r.path_of("path"),
-           "cannot read mesh file " + p.string() + ": " + std::strerror(errno));
-    }
-    s.mesh_path = p.string();
-    s.mesh_where =
-        (o.line > 0 ? o.where + ":" + std::to_string(o.line) : o.where) + ": " + r.path_of("path");
+    std::tie(s.mesh_path, s.mesh_where) = read_mesh_path(r, "path", scene_path);
     s.mesh_scale = r.number("scale");
     s.mesh_translate = r.vec3("translate");
   }
   r.finish();
   return s;
+}
+
+ShellMaterialDesc read_shell_material(const DocNode& node, const std::string& path) {
+  MapReader r(node, "shell_materials[]", path, false);
+  ShellMaterialDesc m;
+  m.name = r.string("name");
+  m.youngs_modulus = r.number("youngs_modulus");
+  m.poisson_ratio = r.number("poisson_ratio");
+  m.density = r.number("density");
+  m.thickness = r.number("thickness");
+  m.yield_stress = r.number("yield_stress");
+  m.damping = r.number("damping");
+  m.stiffness_damping = r.number("stiffness_damping");
+  m.quadrature_inplane = r.int32("quadrature_inplane");
+  if (m.quadrature_inplane != 1 && m.quadrature_inplane != 3 && m.quadrature_inplane != 6 &&
+      m.quadrature_inplane != 7) {
+    fail(r.origin_of("quadrature_inplane"), r.path_of("quadrature_inplane"),
+         "must be one of 1, 3, 6, 7 (points per triangle), got " +
+             std::to_string(m.quadrature_inplane));
+  }
+  m.quadrature_thickness = r.int32("quadrature_thickness");
+  r.finish();
+  return m;
+}
+
+/// Names used in output file names: [A-Za-z0-9_-]+.
+bool file_name_safe(const std::string& name) {
+  if (name.empty()) return false;
+  for (char c : name) {
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || is_digit(c) || c == '_' || c == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+/// Reads the `geometry` block of a shell into `sh`; returns the number of control points of
+/// procedural geometry, or -1 for a mesh file (not known before it is loaded).
+long long read_shell_geometry(MapReader& shell, ShellDesc& sh, const std::string& scene_path,
+                              std::string& type) {
+  MapReader g(*shell.block("geometry"), "shells[].geometry", shell.path_of("geometry"), true);
+  type = g.choice("type");
+  g.check_keys(&type);
+  long long n = -1;
+  if (type == "sheet") {
+    sh.kind = ShellDesc::Kind::Sheet;
+    const std::array<double, 2> size = g.vec2("size");
+    const std::array<int, 2> res = g.int2("resolution");
+    for (int a = 0; a < 2; ++a) {
+      sh.size[a] = size[a];
+      sh.resolution[a] = res[a];
+    }
+    n = (res[0] + 1LL) * (res[1] + 1LL);
+  } else if (type == "cylinder") {
+    sh.kind = ShellDesc::Kind::Cylinder;
+    sh.radius = g.number("radius");
+    sh.height = g.number("height");
+    sh.angle_deg = g.number("angle");
+    const std::array<int, 2> res = g.int2("resolution");
+    sh.resolution[0] = res[0];
+    sh.resolution[1] = res[1];
+    const bool closed = sh.angle_deg == 360.0;
+    if (closed && res[0] < 3) {
+      const DocNode* v = g.present("resolution");
+      const Origin& o = v && v->kind == DocNode::Kind::List && v->items.size() == 2
+                            ? v->items[0].origin
+                            : g.origin_of("resolution");
+      fail(o, g.path_of("resolution") + "[0]",
+           "a closed cylinder (angle 360) needs at least 3 segments around, got " +
+               std::to_string(res[0]));
+    }
+    n = closed ? res[0] * (res[1] + 1LL) : (res[0] + 1LL) * (res[1] + 1LL);
+  } else if (type == "sphere") {
+    sh.kind = ShellDesc::Kind::Sphere;
+    sh.radius = g.number("radius");
+    sh.subdivisions = g.int32("subdivisions");
+    n = 10LL * (1LL << (2 * sh.subdivisions)) + 2;
+  } else {
+    SHELLMPM_CHECK(type == "mesh", "shell geometry type " << type);
+    sh.kind = ShellDesc::Kind::Mesh;
+    std::tie(sh.mesh_path, sh.mesh_where) = read_mesh_path(g, "path", scene_path);
+  }
+  g.finish();
+  return n;
+}
+
+/// "index 121 is out of range: the sheet has 121 vertices (0..120)".
+std::string index_range_message(long long index, long long num_vertices, const std::string& what) {
+  return "index " + std::to_string(index) + " is out of range: " + what + " has " +
+         std::to_string(num_vertices) + " vert" + (num_vertices == 1 ? "ex" : "ices") +
+         (num_vertices > 0 ? " (0.." + std::to_string(num_vertices - 1) + ")" : "");
+}
+
+PinDesc read_pin(const DocNode& node, const std::string& path, const std::string& geometry_type,
+                 const std::string& geometry_path, long long num_vertices, double fps) {
+  MapReader r(node, "shells[].pins[]", path, false);
+  PinDesc pin;
+  const char* selectors[3] = {"indices", "box", "group"};
+  std::vector<std::string> given;
+  for (const char* sel : selectors)
+    if (r.has(sel)) given.push_back(sel);
+  if (given.empty()) {
+    fail(r.origin(), path, "needs exactly one of indices, box, group (none given)");
+  }
+  if (given.size() > 1) {
+    fail(r.key_origin_of(given[1]), r.path_of(given[1]),
+         "give exactly one of indices, box, group (both " + given[0] + " and " + given[1] +
+             " are given)");
+  }
+  const std::string& sel = given[0];
+  pin.where = where_text(r.origin_of(sel), r.path_of(sel));
+  if (sel == "indices") {
+    pin.indices = r.int_list("indices");
+    if (num_vertices >= 0) {
+      const DocNode& list = *r.present("indices");
+      for (std::size_t k = 0; k < pin.indices.size(); ++k) {
+        if (pin.indices[k] >= num_vertices) {
+          fail(list.items[k].origin, r.path_of("indices") + "[" + std::to_string(k) + "]",
+               index_range_message(pin.indices[k], num_vertices, "the " + geometry_type));
+        }
+      }
+    }
+  } else if (sel == "box") {
+    MapReader b(*r.block("box"), "shells[].pins[].box", r.path_of("box"), false);
+    pin.has_box = true;
+    pin.box_min = b.vec3("min");
+    pin.box_max = b.vec3("max");
+    for (int a = 0; a < 3; ++a) {
+      if (!(pin.box_max[a] >= pin.box_min[a])) {
+        fail(b.origin_of("max"), b.path_of("max"),
+             std::string("must be >= min on every axis, but on ") + kAxis[a] +
+                 " max = " + fmt_num(pin.box_max[a]) + " < min = " + fmt_num(pin.box_min[a]));
+      }
+    }
+    b.finish();
+  } else {
+    pin.group = r.string("group");
+    if (geometry_type != "mesh") {
+      fail(r.origin_of("group"), r.path_of("group"),
+           "vertex groups come from a mesh file; " + geometry_path + ".type is " + geometry_type +
+               " (select by indices or box instead)");
+    }
+  }
+  const std::array<bool, 3> comp = r.bool3("components");
+  if (!comp[0] && !comp[1] && !comp[2]) {
+    fail(r.origin_of("components"), r.path_of("components"),
+         "at least one of x, y, z must be true (held); all false pins nothing");
+  }
+  for (int a = 0; a < 3; ++a) pin.components[a] = comp[a];
+  pin.keyframes = read_keyframes(r, "keyframes", "shells[].pins[].keyframes[]", fps);
+  if (r.has("release")) pin.release_time = r.number("release");
+  r.finish();
+  return pin;
+}
+
+ShellDesc read_shell(const DocNode& node, std::size_t i, const Scene& scene,
+                     std::map<std::string, std::string>& names) {
+  const std::string p = "shells[" + std::to_string(i) + "]";
+  MapReader r(node, "shells[]", p, false);
+  ShellDesc sh;
+  sh.name = r.has("name") ? r.string("name") : "shell" + std::to_string(i);
+  if (!file_name_safe(sh.name)) {
+    fail(r.origin_of("name"), r.path_of("name"),
+         "shell name '" + sh.name +
+             "' may hold only letters, digits, '_' and '-' (it is used in output file names)");
+  }
+  if (!names.emplace(sh.name, p).second) {
+    fail(r.origin_of("name"), r.path_of("name"),
+         "duplicate shell name '" + sh.name + "' (also " + names[sh.name] + ")");
+  }
+  const std::string mat = r.string("material");
+  auto found = std::find_if(scene.shell_materials.begin(), scene.shell_materials.end(),
+                            [&](const ShellMaterialDesc& m) { return m.name == mat; });
+  if (found == scene.shell_materials.end()) {
+    std::vector<std::string> known;
+    for (const ShellMaterialDesc& m : scene.shell_materials) known.push_back(m.name);
+    fail(r.origin_of("material"), r.path_of("material"),
+         "unknown shell material '" + mat + "' (" +
+             (known.empty() ? std::string("no shell_materials are defined")
+                            : "shell_materials: " + join(known)) +
+             ")");
+  }
+  sh.material = static_cast<int>(found - scene.shell_materials.begin());
+  std::string type;
+  const long long n = read_shell_geometry(r, sh, scene.path, type);
+  sh.scale = r.number("scale");
+  sh.rotate_deg = r.vec3("rotate");
+  sh.translate = r.vec3("translate");
+  sh.velocity = r.vec3("velocity");
+  sh.pressure = r.number("pressure");
+  const DocNode& loads = *r.block("point_loads");
+  for (std::size_t k = 0; k < loads.items.size(); ++k) {
+    const std::string lp = r.path_of("point_loads") + "[" + std::to_string(k) + "]";
+    MapReader lr(loads.items[k], "shells[].point_loads[]", lp, false);
+    PointLoadDesc load;
+    load.index = lr.int32("index");
+    load.where = where_text(lr.origin_of("index"), lr.path_of("index"));
+    if (n >= 0 && load.index >= n) {
+      fail(lr.origin_of("index"), lr.path_of("index"),
+           index_range_message(load.index, n, "the " + type));
+    }
+    load.force = lr.vec3("force");
+    lr.finish();
+    sh.point_loads.push_back(load);
+  }
+  const DocNode& pins = *r.block("pins");
+  for (std::size_t k = 0; k < pins.items.size(); ++k) {
+    sh.pins.push_back(read_pin(pins.items[k], r.path_of("pins") + "[" + std::to_string(k) + "]",
+                               type, r.path_of("geometry"), n, scene.shot.fps));
+  }
+  sh.output_refine = r.int32("output_refine");
+  sh.write_mesh = r.boolean("write_mesh");
+  r.finish();
+  return sh;
 }
 
 Scene build_scene(const DocNode& root, const std::string& path) {
@@ -1089,11 +1550,7 @@ Scene build_scene(const DocNode& root, const std::string& path) {
     }
     src.material = static_cast<int>(found - scene.materials.begin());
     src.shape = read_shape(*r.block("shape"), r.path_of("shape"), true, path);
-    {
-      const Origin& o = r.origin_of("shape");
-      src.shape.where = (o.line > 0 ? o.where + ":" + std::to_string(o.line) : o.where) + ": " +
-                        r.path_of("shape");
-    }
+    src.shape.where = where_text(r.origin_of("shape"), r.path_of("shape"));
     src.particles_per_cell = r.number("particles_per_cell");
     src.velocity = r.vec3("velocity");
     src.seed = static_cast<unsigned>(r.integer("seed"));
@@ -1130,31 +1587,41 @@ Scene build_scene(const DocNode& root, const std::string& path) {
                  : boundary == "slip" ? BoundaryKind::Slip
                                       : BoundaryKind::Separate;
     c.friction = r.number("friction");
-    const DocNode& keys = *r.block("keyframes");
-    for (std::size_t k = 0; k < keys.items.size(); ++k) {
-      const std::string kp = r.path_of("keyframes") + "[" + std::to_string(k) + "]";
-      MapReader kr(keys.items[k], "colliders[].keyframes[]", kp, false);
-      Keyframe kf;
-      const bool has_time = kr.has("time"), has_frame = kr.has("frame");
-      if (has_time && has_frame) {
-        fail(kr.key_origin_of("frame"), kp, "give either time or frame, not both");
-      }
-      if (!has_time && !has_frame) fail(kr.origin(), kp, "needs a time (seconds) or a frame");
-      // Frame N is the state written as frame N, at t = (N - 1) / fps (frame 1 = start).
-      kf.time = has_time ? kr.number("time") : (kr.int32("frame") - 1) / scene.shot.fps;
-      const std::string tkey = has_time ? "time" : "frame";
-      if (!c.keyframes.empty() && !(kf.time > c.keyframes.back().time)) {
-        fail(kr.origin_of(tkey), kr.path_of(tkey),
-             "keyframe times must strictly increase: " + fmt_num(kf.time) + " s is not after " +
-                 fmt_num(c.keyframes.back().time) + " s (keyframe " + std::to_string(k - 1) + ")");
-      }
-      kf.translate = kr.vec3("translate");
-      kf.rotate_deg = kr.vec3("rotate");
-      kr.finish();
-      c.keyframes.push_back(kf);
-    }
+    c.keyframes = read_keyframes(r, "keyframes", "colliders[].keyframes[]", scene.shot.fps);
     r.finish();
     scene.colliders.push_back(std::move(c));
+  }
+
+  // shell materials
+  std::map<std::string, std::string> shell_material_names;  // name -> path of its first use
+  const DocNode& shell_materials = *top.block("shell_materials");
+  for (std::size_t i = 0; i < shell_materials.items.size(); ++i) {
+    const std::string p = "shell_materials[" + std::to_string(i) + "]";
+    ShellMaterialDesc m = read_shell_material(shell_materials.items[i], p);
+    if (!shell_material_names.emplace(m.name, p).second) {
+      const DocNode* name_node = find_entry(shell_materials.items[i], "name");
+      SHELLMPM_CHECK(name_node != nullptr, "no name in " << p);
+      fail(name_node->origin, p + ".name",
+           "duplicate shell material name '" + m.name + "' (also " + shell_material_names[m.name] +
+               ")");
+    }
+    scene.shell_materials.push_back(std::move(m));
+  }
+
+  // shells
+  std::map<std::string, std::string> shell_names;  // name -> path of its first use
+  const DocNode& shells = *top.block("shells");
+  for (std::size_t i = 0; i < shells.items.size(); ++i) {
+    scene.shells.push_back(read_shell(shells.items[i], i, scene, shell_names));
+  }
+
+  // pre-roll
+  {
+    MapReader r(*top.block("preroll"), "preroll", "preroll", false);
+    scene.preroll.enabled = r.boolean("enabled");
+    scene.preroll.tolerance = r.number("tolerance");
+    scene.preroll.max_steps = r.int32("max_steps");
+    r.finish();
   }
 
   // output
@@ -1175,6 +1642,14 @@ Scene build_scene(const DocNode& root, const std::string& path) {
                          r.path_of("particles_pattern"));
     o.stats_file = r.string("stats");
     o.checkpoint_every = r.int32("checkpoint_every");
+    o.shell_pattern = r.string("shell_pattern");
+    require_one_hash_run(o.shell_pattern, r.origin_of("shell_pattern"), r.path_of("shell_pattern"));
+    if (scene.shells.size() > 1 && o.shell_pattern.find("{name}") == std::string::npos) {
+      fail(r.origin_of("shell_pattern"), r.path_of("shell_pattern"),
+           "must contain {name} (the shell's name) when there is more than one shell (there are " +
+               std::to_string(scene.shells.size()) + "), got '" + o.shell_pattern + "'");
+    }
+    o.shell_format = r.choice("shell_format");
     r.finish();
   }
   top.finish();
@@ -1201,6 +1676,14 @@ std::string KeySpec::type_text() const {
       return "enum";
     case KeyType::Vec3:
       return "vec3";
+    case KeyType::Vec2:
+      return "vec2";
+    case KeyType::Int2:
+      return "int2";
+    case KeyType::IntList:
+      return "integer list";
+    case KeyType::Bool3:
+      return "bool3";
     case KeyType::FrameRange:
       return "frame range";
     case KeyType::Map:
@@ -1250,6 +1733,29 @@ std::string KeySpec::only_for_text() const {
 const std::vector<KeySpec>& scene_schema() {
   static const std::vector<KeySpec> schema = build_schema();
   return schema;
+}
+
+void check_shell_indices(const ShellDesc& shell, int num_vertices, const std::string& scene_path) {
+  SHELLMPM_CHECK(num_vertices >= 0, "num_vertices " << num_vertices);
+  const std::string what = "the mesh of shell '" + shell.name + "'";
+  for (std::size_t j = 0; j < shell.pins.size(); ++j) {
+    const PinDesc& pin = shell.pins[j];
+    for (std::size_t k = 0; k < pin.indices.size(); ++k) {
+      if (pin.indices[k] >= 0 && pin.indices[k] < num_vertices) continue;
+      const std::string fallback =
+          "shell '" + shell.name + "' pins[" + std::to_string(j) + "].indices";
+      throw error_at_where(pin.where, scene_path, fallback, "[" + std::to_string(k) + "]",
+                           index_range_message(pin.indices[k], num_vertices, what));
+    }
+  }
+  for (std::size_t j = 0; j < shell.point_loads.size(); ++j) {
+    const PointLoadDesc& load = shell.point_loads[j];
+    if (load.index >= 0 && load.index < num_vertices) continue;
+    const std::string fallback =
+        "shell '" + shell.name + "' point_loads[" + std::to_string(j) + "].index";
+    throw error_at_where(load.where, scene_path, fallback, "",
+                         index_range_message(load.index, num_vertices, what));
+  }
 }
 
 Scene parse_scene(const std::string& text, const std::string& path,

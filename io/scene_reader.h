@@ -19,6 +19,10 @@ enum class KeyType {
   String,      ///< any scalar
   Enum,        ///< one of KeySpec::choices
   Vec3,        ///< list of exactly 3 numbers
+  Vec2,        ///< list of exactly 2 numbers (bounds apply to each)
+  Int2,        ///< list of exactly 2 integers (bounds apply to each)
+  IntList,     ///< list of integers (bounds apply to each)
+  Bool3,       ///< list of exactly 3 booleans
   FrameRange,  ///< list of exactly 2 integers [first, last]
   Map,         ///< mapping with its own keys
   List,        ///< list of mappings (keys under "<key>[].")
@@ -41,7 +45,8 @@ struct KeySpec {
   Presence presence = Presence::Default;
   std::string default_value;  ///< see Presence
   std::string unit;           ///< "" when dimensionless or not a quantity
-  /// Numeric bounds of Int, Number and FrameRange items (infinite = unbounded).
+  /// Numeric bounds of Int, Number, Vec2, Int2, IntList and FrameRange items (infinite =
+  /// unbounded).
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
   bool min_open = false;              ///< bound excluded: value > min
@@ -69,6 +74,15 @@ const std::vector<KeySpec>& scene_schema();
 ///   before validation; the value is parsed as YAML and replaces the whole value at that key.
 /// @throws UserError naming file, line and key for any problem with the file or an override.
 Scene read_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// Checks the pin and point-load indices of `shell` against its vertex count, for meshes
+/// whose count is known only once the file is loaded (the reader checks procedural geometry
+/// itself). Call it from io/ after loading ShellDesc::mesh.
+/// @param num_vertices number of control points of the shell's mesh (>= 0)
+/// @param scene_path   the scene file, for messages when a pin or load has no `where`
+/// @throws UserError at the offending key ("file:line: shells[0].pins[1].indices[3]", from
+///   PinDesc::where / PointLoadDesc::where) when an index is >= num_vertices.
+void check_shell_indices(const ShellDesc& shell, int num_vertices, const std::string& scene_path);
 
 /// As read_scene, from text; `path` is used for messages and to resolve relative mesh paths.
 Scene parse_scene(const std::string& text, const std::string& path,

@@ -7,6 +7,7 @@
 #include "io/checkpoint.h"
 #include "io/density_vdb.h"
 #include "io/particle_cache.h"
+#include "io/shell_mesh_writer.h"
 #include "io/stats_file.h"
 #include "io/user_error.h"
 #include "sim/solver/solver.h"
@@ -30,6 +31,27 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
   }
   if (o.particles && !scene.sources.empty())
     write_particle_ply(frame_path(o.directory, o.particles_pattern, frame), p);
+  const MeshFormat format = parse_mesh_format(o.shell_format);
+  std::vector<Vec3> pos, nrm;
+  for (const auto& sh : solver.shells()) {
+    if (!sh->desc().write_mesh) continue;
+    sh->output_mesh(pos, nrm);
+    const LimitMesh& lm = sh->limit_mesh();
+    MeshFrame mf;
+    mf.positions = pos.data();
+    mf.num_vertices = pos.size();
+    mf.normals = nrm.data();
+    mf.uvs = lm.uvs().empty() ? nullptr : lm.uvs().data();
+    mf.triangles = lm.triangles().data();
+    mf.num_triangles = lm.triangles().size();
+    mf.frame = frame;
+    mf.time = solver.time();
+    mf.name = sh->name();
+    std::string pattern = o.shell_pattern;
+    const auto at = pattern.find("{name}");
+    if (at != std::string::npos) pattern.replace(at, 6, sh->name());
+    write_shell_mesh(frame_path(o.directory, pattern, frame), mf, format);
+  }
 }
 
 }  // namespace
@@ -75,7 +97,12 @@ int run_shot(const Scene& scene, const RunOptions& opt) {
   header["transfer"] = shot.transfer;
   header["stages"] = solver.stage_names();
   StatsFile stats(out.directory + "/" + out.stats_file, header);
+  if (!resumed && scene.preroll.enabled) {
+    const int steps = solver.preroll(scene.preroll);
+    log("pre-roll settled the shells in " + std::to_string(steps) + " steps");
+  }
   if (resumed) {
+    restore_shells(solver, ck);
     solver.particles() = std::move(ck.particles);
     solver.set_time(ck.time);
     stats.set_frames(nlohmann::json::parse(ck.stats_json));
@@ -106,6 +133,7 @@ int run_shot(const Scene& scene, const RunOptions& opt) {
       c.frame = frame;
       c.time = solver.time();
       c.particles = solver.particles();
+      save_shells(solver, c);
       c.stats_json = stats.frames().dump();
       write_checkpoint(frame_path(out.directory, "checkpoint.####.bin", frame), c);
     }

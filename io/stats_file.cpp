@@ -18,6 +18,14 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
   j["elastic_energy"] = s.elastic_energy;
   j["momentum"] = {s.momentum.x(), s.momentum.y(), s.momentum.z()};
   j["max_speed"] = s.max_speed;
+  if (s.shell_points > 0) {
+    j["shell_points"] = s.shell_points;
+    j["shell_kinetic_energy"] = s.shell_kinetic_energy;
+    j["shell_membrane_energy"] = s.shell_membrane_energy;
+    j["shell_bending_energy"] = s.shell_bending_energy;
+    j["shell_plastic_work"] = s.shell_plastic_work;
+    j["shell_max_strain"] = s.shell_max_strain;
+  }
   nlohmann::json wall = nlohmann::json::object();
   for (const auto& [name, sec] : s.stage_seconds) wall[name] = sec;
   wall["total"] = s.wall_seconds;

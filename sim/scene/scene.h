@@ -129,12 +129,19 @@ struct PinDesc {
   std::string group;                     ///< a named vertex group of the mesh file
   bool components[3] = {true, true, true};  ///< which of x, y, z are held
   Motion keyframes;                      ///< empty: fixed at the rest position; else moves rigidly
+  double release_time = -1;              ///< the pin lets go after this time [s]; < 0: never
+  /// where the selector was given, for messages, as "file:line: key" (UserError's prefix),
+  /// e.g. "shot.yaml:30: shells[0].pins[1].indices" (or .box / .group); may be empty
+  std::string where;
 };
 
 /// A point load on one control point [N].
 struct PointLoadDesc {
   int index = 0;
   Vec3d force{0, 0, 0};
+  /// where `index` was given, as "file:line: key", e.g. "shot.yaml:31:
+  /// shells[0].point_loads[0].index"; may be empty
+  std::string where;
 };
 
 /// A shell object: control mesh from a file or made procedurally.

@@ -20,6 +20,13 @@ struct FrameStats {
   double mass = 0;            ///< total particle mass [kg]
   double max_speed = 0;       ///< [m/s]
   std::size_t grid_blocks = 0;
+  // Shells (all shells summed).
+  std::size_t shell_points = 0;        ///< control points
+  double shell_kinetic_energy = 0;     ///< [J]
+  double shell_membrane_energy = 0;    ///< [J]
+  double shell_bending_energy = 0;     ///< [J]
+  double shell_plastic_work = 0;       ///< dissipated by denting since the start [J]
+  double shell_max_strain = 0;         ///< largest principal Hencky strain
   /// Wall-clock seconds per stage, in stage order (not deterministic, unlike the rest).
   std::vector<std::pair<std::string, double>> stage_seconds;
   double wall_seconds = 0;

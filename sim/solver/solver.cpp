@@ -51,6 +51,12 @@ Solver::Solver(const Scene& scene, SolverOptions opt) : scene_(scene), opt_(opt)
     any_emit_ = any_emit_ || src.emit;
   }
   for (const ColliderDesc& c : scene_.colliders) colliders_.emplace_back(c);
+  for (const ShellDesc& sd : scene_.shells) {
+    shells_.push_back(std::make_unique<ShellObject>(sd, scene_.shell_materials[sd.material],
+                                                    build_shell_rest_mesh(sd)));
+    shell_dt_ = std::min(shell_dt_, shells_.back()->stable_dt(s.cfl));
+  }
+  shell_forces_.resize(shells_.size());
   if (opt_.fill_sources) {
     for (std::size_t i = 0; i < samplers_.size(); ++i) {
       if (scene_.sources[i].emit) continue;
@@ -74,6 +80,23 @@ void Solver::add_particles_from(std::size_t i, const std::vector<Vec3d>& pts) {
 
 void Solver::build_stages() {
   stages_.clear();
+  if (!shells_.empty()) {
+    // Shells without contact: control points integrate directly, no grid.
+    stages_.push_back({"shell_forces", [this] {
+                         for (std::size_t i = 0; i < shells_.size(); ++i)
+                           shells_[i]->forces(scene_.shot.gravity, shell_forces_[i], opt_.serial);
+                       }});
+    stages_.push_back({"shell_update", [this] {
+                         for (std::size_t i = 0; i < shells_.size(); ++i)
+                           shells_[i]->integrate(shell_forces_[i], time_, dt_, opt_.serial);
+                       }});
+    bool denting = false;
+    for (const auto& sh : shells_) denting = denting || sh->has_denting();
+    if (denting)
+      stages_.push_back({"denting", [this] {
+                           for (auto& sh : shells_) plastic_work_ += sh->project_plasticity(opt_.serial);
+                         }});
+  }
   const bool bulk = !scene_.sources.empty();
   if (!bulk) return;
   stages_.push_back({"bin", [this] { grid_.bin(particles_.x, opt_.serial); }});
@@ -192,7 +215,7 @@ void Solver::clamp_to_domain() {
 
 double Solver::stable_dt() const {
   const ShotSettings& s = scene_.shot;
-  double dt = s.dt_max;
+  double dt = std::min(s.dt_max, shell_dt_);
   const std::size_t n = particles_.size();
   if (n == 0) return dt;
   double vmax = 0, cmax = 0;
@@ -305,11 +328,61 @@ void Solver::measure(FrameStats& s) const {
            models_[mat].energy(p.F[i], p.has_plastic() ? p.plastic[i] : Real(1));
     return a;
   });
+  for (const auto& sh : shells_) {
+    const KirchhoffLoveShell::Energy e = sh->kl().energy(sh->x.data(), nullptr, opt_.serial);
+    s.shell_points += sh->size();
+    s.shell_kinetic_energy += sh->kinetic_energy();
+    s.shell_membrane_energy += static_cast<double>(e.membrane);
+    s.shell_bending_energy += static_cast<double>(e.bending);
+    s.shell_max_strain = std::max(s.shell_max_strain, sh->max_strain());
+  }
+  s.shell_plastic_work = plastic_work_;
   s.kinetic_energy = total.ke;
   s.elastic_energy = total.pe;
   s.mass = total.m;
   s.momentum = total.mom;
   s.max_speed = total.vmax;
+}
+
+int Solver::preroll(const PrerollSettings& p) {
+  if (shells_.empty()) return 0;
+  // Reference force scale: the largest weight of a control point (or 1 N without gravity).
+  double fref = 0;
+  for (const auto& sh : shells_)
+    for (Real m : sh->mass) fref = std::max(fref, m * scene_.shot.gravity.norm());
+  for (const auto& sh : shells_)
+    for (const PointLoadDesc& pl : sh->desc().point_loads) fref = std::max(fref, pl.force.norm());
+  if (fref <= 0) fref = 1;
+  double ke_prev = 0;
+  for (int step = 1; step <= p.max_steps; ++step) {
+    double residual = 0, ke = 0;
+    for (std::size_t i = 0; i < shells_.size(); ++i) {
+      ShellObject& sh = *shells_[i];
+      sh.forces(scene_.shot.gravity, shell_forces_[i], opt_.serial);
+      for (std::size_t j = 0; j < sh.size(); ++j)
+        for (int a = 0; a < 3; ++a)
+          if (!(sh.pin_mask[j] & (1u << a)))
+            residual = std::max(residual, std::abs(double(shell_forces_[i][j][a])));
+      sh.integrate(shell_forces_[i], time_, shell_dt_, opt_.serial);
+      ke += sh.kinetic_energy();
+    }
+    if (residual / fref < p.tolerance) {
+      for (auto& sh : shells_)
+        for (auto& v : sh->v) v.setZero();
+      return step;
+    }
+    // Kinetic damping: at a peak of kinetic energy, stop every point.
+    if (ke < ke_prev) {
+      for (auto& sh : shells_)
+        for (auto& v : sh->v) v.setZero();
+      ke = 0;
+    }
+    ke_prev = ke;
+  }
+  std::ostringstream os;
+  os << "pre-roll did not settle within preroll.max_steps = " << p.max_steps
+     << " steps (tolerance " << p.tolerance << ")";
+  throw SimulationError(os.str());
 }
 
 }  // namespace shellmpm

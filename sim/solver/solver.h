@@ -14,6 +14,7 @@
 #include "sim/mpm/sparse_grid.h"
 #include "sim/scene/scene.h"
 #include "sim/solver/frame_stats.h"
+#include "sim/shell/shell_object.h"
 #include "sim/solver/source_sampler.h"
 
 namespace shellmpm {
@@ -53,6 +54,15 @@ class Solver {
   const std::vector<Real>& densities() const { return densities_; }
   const std::vector<SourceSampler>& samplers() const { return samplers_; }
   const Scene& scene() const { return scene_; }
+  std::vector<std::unique_ptr<ShellObject>>& shells() { return shells_; }
+  const std::vector<std::unique_ptr<ShellObject>>& shells() const { return shells_; }
+  /// Plastic work dissipated by denting so far [J] (part of the checkpointed state).
+  double shell_plastic_work() const { return plastic_work_; }
+  void set_shell_plastic_work(double w) { plastic_work_ = w; }
+  /// Settles the shells to static equilibrium (damped dynamic relaxation with kinetic
+  /// damping) without advancing time; returns the number of steps taken.
+  /// Throws SimulationError when the residual does not fall below the tolerance.
+  int preroll(const PrerollSettings& p);
 
  private:
   struct Stage {
@@ -78,6 +88,10 @@ class Solver {
   ParticleSet particles_;
   SparseGrid grid_;
   std::vector<Stage> stages_;
+  std::vector<std::unique_ptr<ShellObject>> shells_;
+  std::vector<std::vector<Vec3>> shell_forces_;
+  double shell_dt_ = 1e300;
+  double plastic_work_ = 0;
   double time_ = 0, dt_ = 0;
   Vec3i domain_cells_{0, 0, 0};
   bool any_plastic_ = false, any_emit_ = false;

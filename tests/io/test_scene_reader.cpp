@@ -400,7 +400,8 @@ TEST_CASE("bad scenes name the file, line and key", "[scene]") {
   SECTION("unknown keys, top-level and nested") {
     expect_error(kHead + "colider: []\n", 5, "colider",
                  {"unknown key 'colider' in the top level",
-                  "(known: version, shot, materials, sources, colliders, output)"});
+                  "(known: version, shot, materials, sources, colliders, shell_materials, shells, "
+                  "preroll, output)"});
     expect_error(kHead + "  dxx: 0.2\n", 5, "shot.dxx",
                  {"unknown key 'dxx' in shot (known: frames, fps, cfl,"});
     expect_error(kHead + kSand + "sources:\n  - material: sand\n    colour: red\n", 9,
@@ -564,6 +565,393 @@ TEST_CASE("bad scenes name the file, line and key", "[scene]") {
     CHECK(e.file == kScenes + "no_such_scene.yaml");
     CHECK(e.line == 0);
     CHECK(std::string(e.what()).find("cannot open scene file") != std::string::npos);
+  }
+}
+
+TEST_CASE("a shell scene parses with the values written", "[scene][shell]") {
+  const std::string file = kScenes + "shells.yaml";
+  const Scene s = read_scene(file);
+  CHECK(s.materials.empty());  // shells need no bulk materials or sources
+  CHECK(s.sources.empty());
+
+  REQUIRE(s.shell_materials.size() == 2);
+  const ShellMaterialDesc& cotton = s.shell_materials[0];
+  CHECK(cotton.name == "cotton");
+  CHECK(cotton.youngs_modulus == 2.5e6);
+  CHECK(cotton.poisson_ratio == 0.35);
+  CHECK(cotton.density == 500.0);
+  CHECK(cotton.thickness == 0.002);
+  CHECK(cotton.yield_stress == 1e4);
+  CHECK(cotton.damping == 0.5);
+  CHECK(cotton.stiffness_damping == 1e-4);
+  CHECK(cotton.quadrature_inplane == 6);
+  CHECK(cotton.quadrature_thickness == 5);
+  CHECK(s.shell_materials[1].name == "tin");
+
+  REQUIRE(s.shells.size() == 4);
+  const ShellDesc& cloth = s.shells[0];
+  CHECK(cloth.name == "cloth-1");
+  CHECK(cloth.material == 0);
+  CHECK(cloth.kind == ShellDesc::Kind::Sheet);
+  CHECK(cloth.size[0] == 2.0);
+  CHECK(cloth.size[1] == 1.5);
+  CHECK(cloth.resolution[0] == 20);
+  CHECK(cloth.resolution[1] == 10);
+  CHECK(cloth.scale == 0.5);
+  CHECK(vec_eq(cloth.rotate_deg, Vec3d(90, 0, 45)));
+  CHECK(vec_eq(cloth.translate, Vec3d(0, 1, 0)));
+  CHECK(vec_eq(cloth.velocity, Vec3d(0, -1, 0)));
+  CHECK(cloth.pressure == 12.5);
+  REQUIRE(cloth.point_loads.size() == 1);
+  CHECK(cloth.point_loads[0].index == 230);  // the last of (20 + 1) * (10 + 1) vertices
+  CHECK(vec_eq(cloth.point_loads[0].force, Vec3d(0, -2, 0)));
+  CHECK(cloth.point_loads[0].where == file + ":30: shells[0].point_loads[0].index");
+  REQUIRE(cloth.pins.size() == 2);
+  const PinDesc& p0 = cloth.pins[0];
+  CHECK(p0.indices == std::vector<int>{0, 20});
+  CHECK_FALSE(p0.has_box);
+  CHECK(p0.group.empty());
+  CHECK(p0.components[0]);
+  CHECK_FALSE(p0.components[1]);
+  CHECK(p0.components[2]);
+  CHECK(p0.where == file + ":32: shells[0].pins[0].indices");
+  REQUIRE(p0.keyframes.size() == 2);
+  CHECK(p0.keyframes[0].time == 0.0);
+  CHECK(p0.keyframes[1].time == Approx(1.0));  // frame 26 at 25 fps
+  CHECK(vec_eq(p0.keyframes[1].translate, Vec3d(0, 1, 0)));
+  CHECK(vec_eq(p0.keyframes[1].rotate_deg, Vec3d(0, 45, 0)));
+  const PinDesc& p1 = cloth.pins[1];
+  CHECK(p1.has_box);
+  CHECK(p1.indices.empty());
+  CHECK(vec_eq(p1.box_min, Vec3d(-1, -1, -1)));
+  CHECK(vec_eq(p1.box_max, Vec3d(1, 1, -0.5)));
+  CHECK(p1.keyframes.empty());
+  CHECK(cloth.output_refine == 2);
+  CHECK_FALSE(cloth.write_mesh);
+
+  const ShellDesc& can = s.shells[1];
+  CHECK(can.name == "can");
+  CHECK(can.material == 1);
+  CHECK(can.kind == ShellDesc::Kind::Cylinder);
+  CHECK(can.radius == 0.1);
+  CHECK(can.height == 0.3);
+  CHECK(can.angle_deg == 180.0);
+  CHECK(can.resolution[0] == 2);  // an open patch may have fewer than 3 segments around
+  CHECK(can.resolution[1] == 4);
+
+  const ShellDesc& ball = s.shells[2];
+  CHECK(ball.name == "shell2");
+  CHECK(ball.kind == ShellDesc::Kind::Sphere);
+  CHECK(ball.radius == 0.2);
+  CHECK(ball.subdivisions == 3);
+
+  const ShellDesc& rag = s.shells[3];
+  CHECK(rag.kind == ShellDesc::Kind::Mesh);
+  CHECK(rag.mesh_path == kScenes + "tetra.obj");
+  CHECK(rag.mesh_where == file + ":49: shells[3].geometry.path");
+  CHECK(rag.mesh == nullptr);  // loaded by io/, not by the reader
+  REQUIRE(rag.pins.size() == 2);
+  CHECK(rag.pins[0].group == "top");
+  CHECK(rag.pins[1].indices == std::vector<int>{100000});  // checked once the mesh is loaded
+
+  CHECK(s.preroll.enabled);
+  CHECK(s.preroll.tolerance == 1e-6);
+  CHECK(s.preroll.max_steps == 5000);
+  CHECK(s.output.shell_pattern == "shells/{name}_####.obj");
+  CHECK(s.output.shell_format == "obj");
+
+  SECTION("check_shell_indices reports mesh indices at the key that gave them") {
+    check_shell_indices(rag, 100001, s.path);  // in range: no error
+    const UserError e = catch_user_error([&] { check_shell_indices(rag, 4, s.path); });
+    CHECK(e.file == file);
+    CHECK(e.line == 52);
+    CHECK(e.key == "shells[3].pins[1].indices[0]");
+    CHECK(std::string(e.what()).find("index 100000 is out of range") != std::string::npos);
+    CHECK(std::string(e.what()).find("has 4 vertices (0..3)") != std::string::npos);
+    const UserError l = catch_user_error([&] { check_shell_indices(cloth, 200, s.path); });
+    CHECK(l.file == file);
+    CHECK(l.line == 30);
+    CHECK(l.key == "shells[0].point_loads[0].index");
+    // Without a `where` (a ShellDesc built in code) the scene file and shell name are used.
+    ShellDesc bare;
+    bare.name = "b";
+    bare.pins.push_back(PinDesc{});
+    bare.pins[0].indices = {7};
+    const UserError b = catch_user_error([&] { check_shell_indices(bare, 5, "x.yaml"); });
+    CHECK(b.file == "x.yaml");
+    CHECK(b.line == 0);
+    CHECK(b.key == "shell 'b' pins[0].indices[0]");
+  }
+  SECTION("from an override, the location is the --set") {
+    const std::string ov = "shells[3].pins[1].indices=[9]";
+    const Scene o = read_scene(file, {ov});
+    const UserError e = catch_user_error([&] { check_shell_indices(o.shells[3], 4, o.path); });
+    CHECK(e.file == "--set " + ov);
+    CHECK(e.line == 0);
+    CHECK(e.key == "shells[3].pins[1].indices[0]");
+  }
+}
+
+TEST_CASE("shell keys left out take the defaults of scene.h", "[scene][shell]") {
+  const Scene s = parse_scene(kHead +
+                                  "shell_materials: [{name: m}]\n"
+                                  "shells:\n"
+                                  "  - {material: m, geometry: {type: sheet}}\n"
+                                  "  - material: m\n"
+                                  "    geometry: {type: cylinder}\n"
+                                  "    pins: [{box: {min: [0, 0, 0], max: [0, 0, 0]}}]\n"
+                                  "  - {material: m, geometry: {type: sphere}}\n",
+                              "scenes/defaults.yaml");
+  const ShellMaterialDesc md;
+  REQUIRE(s.shell_materials.size() == 1);
+  const ShellMaterialDesc& m = s.shell_materials[0];
+  CHECK(m.youngs_modulus == md.youngs_modulus);
+  CHECK(m.poisson_ratio == md.poisson_ratio);
+  CHECK(m.density == md.density);
+  CHECK(m.thickness == md.thickness);
+  CHECK(m.yield_stress == md.yield_stress);
+  CHECK(m.damping == md.damping);
+  CHECK(m.stiffness_damping == md.stiffness_damping);
+  CHECK(m.quadrature_inplane == md.quadrature_inplane);
+  CHECK(m.quadrature_thickness == md.quadrature_thickness);
+
+  const ShellDesc d;
+  REQUIRE(s.shells.size() == 3);
+  for (std::size_t i = 0; i < s.shells.size(); ++i) {
+    const ShellDesc& sh = s.shells[i];
+    CAPTURE(i);
+    CHECK(sh.name == "shell" + std::to_string(i));
+    CHECK(sh.material == 0);
+    CHECK(sh.scale == d.scale);
+    CHECK(vec_eq(sh.rotate_deg, d.rotate_deg));
+    CHECK(vec_eq(sh.translate, d.translate));
+    CHECK(vec_eq(sh.velocity, d.velocity));
+    CHECK(sh.pressure == d.pressure);
+    CHECK(sh.point_loads.empty());
+    CHECK(sh.output_refine == d.output_refine);
+    CHECK(sh.write_mesh == d.write_mesh);
+  }
+  CHECK(s.shells[0].kind == ShellDesc::Kind::Sheet);
+  CHECK(s.shells[0].size[0] == d.size[0]);
+  CHECK(s.shells[0].size[1] == d.size[1]);
+  CHECK(s.shells[0].resolution[0] == d.resolution[0]);
+  CHECK(s.shells[0].resolution[1] == d.resolution[1]);
+  CHECK(s.shells[0].pins.empty());
+  CHECK(s.shells[1].kind == ShellDesc::Kind::Cylinder);
+  CHECK(s.shells[1].radius == d.radius);
+  CHECK(s.shells[1].height == d.height);
+  CHECK(s.shells[1].angle_deg == d.angle_deg);
+  CHECK(s.shells[1].resolution[0] == d.resolution[0]);
+  REQUIRE(s.shells[1].pins.size() == 1);
+  const PinDesc pd;
+  const PinDesc& pin = s.shells[1].pins[0];
+  CHECK(pin.has_box);  // a zero-size box is allowed (max >= min)
+  for (int a = 0; a < 3; ++a) CHECK(pin.components[a] == pd.components[a]);
+  CHECK(pin.keyframes.empty());
+  CHECK(s.shells[2].kind == ShellDesc::Kind::Sphere);
+  CHECK(s.shells[2].radius == d.radius);
+  CHECK(s.shells[2].subdivisions == d.subdivisions);
+
+  const PrerollSettings pr;
+  CHECK(s.preroll.enabled == pr.enabled);
+  CHECK(s.preroll.tolerance == pr.tolerance);
+  CHECK(s.preroll.max_steps == pr.max_steps);
+  const OutputSettings od;
+  CHECK(s.output.shell_pattern == od.shell_pattern);
+  CHECK(s.output.shell_format == od.shell_format);
+
+  // A scene without shells takes the defaults too.
+  const Scene none = read_scene(kScenes + "minimal.yaml");
+  CHECK(none.shell_materials.empty());
+  CHECK(none.shells.empty());
+  CHECK(none.preroll.enabled == pr.enabled);
+  CHECK(none.output.shell_pattern == od.shell_pattern);
+}
+
+TEST_CASE("bad shell scenes name the file, line and key", "[scene][shell]") {
+  // lines 5-6 after kHead
+  const std::string mats =
+      "shell_materials:\n"
+      "  - {name: cotton}\n";
+  const std::string sheet = "{type: sheet, resolution: [2, 2]}";  // 9 vertices
+  SECTION("unknown shell material") {
+    expect_error(kHead + mats + "shells:\n  - {material: cottn, geometry: " + sheet + "}\n", 8,
+                 "shells[0].material",
+                 {"unknown shell material 'cottn' (shell_materials: cotton)"});
+    expect_error(kHead + "shells:\n  - {material: cotton, geometry: " + sheet + "}\n", 6,
+                 "shells[0].material", {"no shell_materials are defined"});
+    // bulk materials are another namespace
+    expect_error(kHead + kSand + "shells:\n  - {material: sand, geometry: " + sheet + "}\n", 8,
+                 "shells[0].material", {"unknown shell material 'sand'"});
+  }
+  SECTION("shell names") {
+    expect_error(kHead + mats +
+                     "shells:\n"
+                     "  - {name: a, material: cotton, geometry: " +
+                     sheet +
+                     "}\n"
+                     "  - {name: a, material: cotton, geometry: " +
+                     sheet + "}\n",
+                 9, "shells[1].name", {"duplicate shell name 'a' (also shells[0])"});
+    expect_error(kHead + mats +
+                     "shells:\n"
+                     "  - {name: shell1, material: cotton, geometry: " +
+                     sheet +
+                     "}\n"
+                     "  - {material: cotton, geometry: " +
+                     sheet + "}\n",
+                 9, "shells[1].name", {"duplicate shell name 'shell1' (also shells[0])"});
+    expect_error(
+        kHead + mats + "shells:\n  - {name: my cloth, material: cotton, geometry: " + sheet + "}\n",
+        8, "shells[0].name", {"'my cloth'", "letters, digits, '_' and '-'"});
+    expect_error(
+        kHead + mats + "shells:\n  - {name: a/b, material: cotton, geometry: " + sheet + "}\n", 8,
+        "shells[0].name", {"only letters"});
+    expect_error(kHead + mats + "  - {name: cotton}\n", 7, "shell_materials[1].name",
+                 {"duplicate shell material name 'cotton' (also shell_materials[0])"});
+  }
+  SECTION("pin selectors") {
+    const std::string head = kHead + mats +
+                             "shells:\n  - material: cotton\n    geometry: " + sheet +
+                             "\n    pins:\n";  // pins from line 11
+    expect_error(head + "      - indices: [0]\n        box: {min: [0,0,0], max: [1,1,1]}\n", 12,
+                 "shells[0].pins[0].box",
+                 {"give exactly one of indices, box, group", "indices and box"});
+    expect_error(head + "      - {components: [true, true, true]}\n", 11, "shells[0].pins[0]",
+                 {"needs exactly one of indices, box, group (none given)"});
+    expect_error(head + "      - {group: top}\n", 11, "shells[0].pins[0].group",
+                 {"vertex groups come from a mesh file", "shells[0].geometry.type is sheet"});
+    expect_error(head + "      - {indices: [0], components: [false, false, false]}\n", 11,
+                 "shells[0].pins[0].components", {"at least one of x, y, z must be true"});
+    expect_error(head + "      - {indices: [0], components: [true, 1, true]}\n", 11,
+                 "shells[0].pins[0].components[1]", {"expected true or false, got '1'"});
+    expect_error(head + "      - {indices: [0], components: [true, true]}\n", 11,
+                 "shells[0].pins[0].components", {"expected a list of 3 booleans"});
+    expect_error(head + "      - {indices: []}\n", 11, "shells[0].pins[0].indices",
+                 {"must not be empty"});
+    expect_error(head + "      - indices:\n          - 1\n          - -2\n", 13,
+                 "shells[0].pins[0].indices[1]", {"must be >= 0, got -2"});
+    expect_error(head + "      - {box: {min: [0,0,0], max: [1,-1,1]}}\n", 11,
+                 "shells[0].pins[0].box.max", {"on y max = -1 < min = 0"});
+    expect_error(head + "      - {indices: [0], keyframes: [{frame: 5}, {frame: 5}]}\n", 11,
+                 "shells[0].pins[0].keyframes[1].frame", {"strictly increase"});
+    expect_error(head + "      - {indices: [0], keyframes: [{time: 0, frame: 1}]}\n", 11,
+                 "shells[0].pins[0].keyframes[0]", {"either time or frame, not both"});
+  }
+  SECTION("indices out of range of procedural geometry") {
+    const std::string head = kHead + mats +
+                             "shells:\n  - material: cotton\n    geometry: " + sheet +
+                             "\n";  // line 10 next
+    expect_error(head + "    pins:\n      - indices:\n          - 8\n          - 9\n", 13,
+                 "shells[0].pins[0].indices[1]",
+                 {"index 9 is out of range: the sheet has 9 vertices (0..8)"});
+    expect_error(head + "    point_loads: [{index: 9, force: [0, 1, 0]}]\n", 10,
+                 "shells[0].point_loads[0].index", {"index 9 is out of range: the sheet"});
+    // closed cylinder n_around * (n_along + 1) = 12, open (n_around + 1) * (n_along + 1) = 15
+    const std::string cyl = kHead + mats + "shells:\n  - material: cotton\n";
+    expect_error(cyl +
+                     "    geometry: {type: cylinder, resolution: [4, 2]}\n"
+                     "    pins: [{indices: [12]}]\n",
+                 10, "shells[0].pins[0].indices[0]", {"the cylinder has 12 vertices"});
+    CHECK_NOTHROW(parse_scene(cyl +
+                                  "    geometry: {type: cylinder, angle: 90, resolution: [4, 2]}\n"
+                                  "    pins: [{indices: [14]}]\n",
+                              "scenes/ok.yaml"));
+    // sphere 10 * 4^s + 2: 42 at s = 1
+    expect_error(cyl +
+                     "    geometry: {type: sphere, subdivisions: 1}\n"
+                     "    point_loads: [{index: 42, force: [0, 0, 0]}]\n",
+                 10, "shells[0].point_loads[0].index", {"the sphere has 42 vertices (0..41)"});
+    CHECK_NOTHROW(parse_scene(cyl + "    geometry: {type: sphere, subdivisions: 1}\n"
+                                    "    point_loads: [{index: 41, force: [0, 0, 0]}]\n",
+                              "scenes/ok.yaml"));
+  }
+  SECTION("shell material ranges") {
+    expect_error(kHead + "shell_materials:\n  - {name: m, quadrature_inplane: 4}\n", 6,
+                 "shell_materials[0].quadrature_inplane", {"must be one of 1, 3, 6, 7", "got 4"});
+    expect_error(kHead + "shell_materials:\n  - {name: m, thickness: 0}\n", 6,
+                 "shell_materials[0].thickness", {"must be > 0, got 0"});
+    expect_error(kHead + "shell_materials:\n  - {name: m, quadrature_thickness: 6}\n", 6,
+                 "shell_materials[0].quadrature_thickness", {"must be in [1, 5], got 6"});
+    expect_error(kHead + "shell_materials:\n  - {name: m, poisson_ratio: 0.5}\n", 6,
+                 "shell_materials[0].poisson_ratio", {"must be in [0, 0.5)"});
+    expect_error(kHead + "shell_materials:\n  - {name: m, density: 1, type: elastic}\n", 6,
+                 "shell_materials[0].type", {"unknown key 'type' in shell_materials[0]"});
+  }
+  SECTION("geometry") {
+    const std::string head = kHead + mats + "shells:\n  - material: cotton\n";  // line 9 next
+    expect_error(head + "    geometry: {type: sheet, resolution: [0, 4]}\n", 9,
+                 "shells[0].geometry.resolution[0]", {"must be in [1, 2000], got 0"});
+    expect_error(head + "    geometry: {type: sheet, resolution: [4, 2001]}\n", 9,
+                 "shells[0].geometry.resolution[1]", {"must be in [1, 2000], got 2001"});
+    expect_error(head + "    geometry: {type: sheet, resolution: [4, 2.5]}\n", 9,
+                 "shells[0].geometry.resolution[1]", {"expected an integer"});
+    expect_error(head + "    geometry: {type: sheet, size: [1, 0]}\n", 9,
+                 "shells[0].geometry.size[1]", {"must be > 0, got 0"});
+    expect_error(head + "    geometry: {type: sheet, size: [1, 1, 1]}\n", 9,
+                 "shells[0].geometry.size", {"expected a list of 2 numbers"});
+    expect_error(head + "    geometry: {type: sphere, subdivisions: 9}\n", 9,
+                 "shells[0].geometry.subdivisions", {"must be in [0, 7], got 9"});
+    expect_error(head + "    geometry: {type: sphere, radius: 1, height: 2}\n", 9,
+                 "shells[0].geometry.height",
+                 {"'height' is not allowed for type sphere",
+                  "keys for sphere: type, radius, "
+                  "subdivisions"});
+    expect_error(head + "    geometry: {type: cylinder, resolution: [2, 4]}\n", 9,
+                 "shells[0].geometry.resolution[0]",
+                 {"closed cylinder (angle 360) needs at least 3 segments around, got 2"});
+    expect_error(head + "    geometry: {type: cylinder, angle: 361}\n", 9,
+                 "shells[0].geometry.angle", {"must be in (0, 360], got 361"});
+    expect_error(head + "    geometry: {type: cone}\n", 9, "shells[0].geometry.type",
+                 {"expected one of sheet, cylinder, sphere, mesh, got 'cone'"});
+    expect_error(head + "    geometry: {type: mesh, path: no_such.obj}\n", 9,
+                 "shells[0].geometry.path", {"mesh file not found"});
+    expect_error(head + "    scale: 1\n", 8, "shells[0].geometry", {"required key 'geometry'"});
+    expect_error(head + "    geometry: {type: sheet}\n    output_refine: 5\n", 10,
+                 "shells[0].output_refine", {"must be in [0, 4], got 5"});
+    expect_error(head + "    geometry: {type: sheet}\n    point_loads: [{index: 0}]\n", 10,
+                 "shells[0].point_loads[0].force", {"required key 'force' is missing"});
+  }
+  SECTION("pre-roll and output") {
+    expect_error(kHead + "preroll: {tolerance: 0}\n", 5, "preroll.tolerance", {"must be > 0"});
+    expect_error(kHead + "preroll: {max_steps: 0}\n", 5, "preroll.max_steps",
+                 {"must be >= 1, got 0"});
+    expect_error(kHead + "preroll: {enabled: yes}\n", 5, "preroll.enabled",
+                 {"expected true or false"});
+    const std::string two = kHead + mats +
+                            "shells:\n"
+                            "  - {material: cotton, geometry: " +
+                            sheet +
+                            "}\n"
+                            "  - {material: cotton, geometry: " +
+                            sheet + "}\n";  // line 10 next
+    expect_error(two + "output:\n  shell_pattern: cloth.####.ply\n", 11, "output.shell_pattern",
+                 {"must contain {name}", "more than one shell", "'cloth.####.ply'"});
+    expect_error(kHead + "output:\n  shell_pattern: \"{name}.ply\"\n", 6, "output.shell_pattern",
+                 {"exactly one run of '#'"});
+    expect_error(kHead + "output:\n  shell_format: abc\n", 6, "output.shell_format",
+                 {"expected one of ply, obj, glb, got 'abc'"});
+    // One shell needs no {name}.
+    const Scene one = parse_scene(kHead + mats + "shells: [{material: cotton, geometry: " + sheet +
+                                      "}]\n" + "output: {shell_pattern: cloth.####.ply}\n",
+                                  "scenes/ok.yaml");
+    CHECK(one.output.shell_pattern == "cloth.####.ply");
+  }
+  SECTION("overrides reach shell keys") {
+    const std::string text =
+        kHead + mats + "shells:\n  - {material: cotton, geometry: " + sheet + "}\n";
+    const Scene s =
+        parse_scene(text, "scenes/ok.yaml",
+                    {"shells[0].geometry.resolution=[3, 4]", "shells.0.pins=[{indices: [19]}]",
+                     "shell_materials[0].thickness=0.01", "preroll.enabled=true"});
+    CHECK(s.shells[0].resolution[0] == 3);
+    CHECK(s.shells[0].pins[0].indices == std::vector<int>{19});  // (3 + 1) * (4 + 1) = 20
+    CHECK(s.shell_materials[0].thickness == 0.01);
+    CHECK(s.preroll.enabled);
+    expect_override_error(text, "shells[0].geometry.resolution=[0, 4]",
+                          "shells[0].geometry.resolution[0]", {"must be in [1, 2000]"});
+    expect_override_error(text, "shells[0].geometry.radius=1", "shells[0].geometry.radius",
+                          {"'radius' is not allowed for type sheet"});
   }
 }
 

@@ -1,0 +1,91 @@
+// bench/shell_throughput: Kirchhoff-Love shell forces on a sheet of about 100k control
+// points (grid-free explicit steps). Prints quadrature-point evaluations per second
+// (per in-plane point with all thickness layers, and per layer) and ms per step at 1
+// and 2 threads, with the split between force evaluation and the update.
+//
+//   shell_throughput [--vertices N] [--steps S] [--threads 1,2]
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "sim/core/parallel.h"
+#include "sim/solver/solver.h"
+
+using namespace shellmpm;
+
+int main(int argc, char** argv) {
+  double vertices = 100000;
+  int steps = 20;
+  std::vector<int> threads = {1, 2};
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string k = argv[i];
+    if (k == "--vertices") vertices = std::atof(argv[i + 1]);
+    else if (k == "--steps") steps = std::atoi(argv[i + 1]);
+    else if (k == "--threads") {
+      threads.clear();
+      std::stringstream ss(argv[i + 1]);
+      std::string t;
+      while (std::getline(ss, t, ',')) threads.push_back(std::atoi(t.c_str()));
+    } else {
+      std::fprintf(stderr, "unknown option %s\n", k.c_str());
+      return 2;
+    }
+  }
+  const int n = static_cast<int>(std::round(std::sqrt(vertices))) - 1;
+  Scene s;
+  s.path = "bench";
+  s.shot.dx = 0.01;
+  s.shot.domain_min = Vec3d(-5, -5, -5);
+  s.shot.domain_max = Vec3d(5, 5, 5);
+  ShellMaterialDesc m;
+  m.name = "cloth";
+  m.youngs_modulus = 1e6;
+  m.density = 300;
+  m.thickness = 1e-3;
+  s.shell_materials.push_back(m);
+  ShellDesc sh;
+  sh.name = "sheet";
+  sh.kind = ShellDesc::Kind::Sheet;
+  sh.size[0] = sh.size[1] = 2.0;
+  sh.resolution[0] = sh.resolution[1] = n;
+  PinDesc pin;
+  pin.indices = {0, n};
+  sh.pins.push_back(pin);
+  s.shells.push_back(sh);
+  const auto t_setup = std::chrono::steady_clock::now();
+  Solver probe(s);
+  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
+  const auto& kl = probe.shells()[0]->kl();
+  const double qp = static_cast<double>(kl.num_quadrature_points());
+  const int layers = kl.num_layers();
+  std::printf("shell_throughput: sheet %dx%d quads, %zu control points, %.0f in-plane quadrature "
+              "points x %d layers, %s, setup %.2f s\n",
+              n, n, probe.shells()[0]->size(), qp, layers, sizeof(Real) == 4 ? "float" : "double",
+              setup);
+  double base = 0;
+  for (int t : threads) {
+    ThreadLimit limit(t);
+    Solver solver(s);
+    const double dt = solver.stable_dt();
+    solver.advance_to(2 * dt);  // warm up
+    const double t0 = solver.time();
+    const auto w0 = std::chrono::steady_clock::now();
+    const FrameStats fs = solver.advance_to(t0 + steps * dt);
+    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    double forces = 0;
+    for (const auto& [name, v] : fs.stage_seconds)
+      if (name == "shell_forces") forces = v;
+    const double per_step = sec / fs.substeps;
+    const double qps = qp * fs.substeps / forces;
+    if (base == 0) base = per_step;
+    std::printf("threads %d: %.2f ms per step (forces %.2f ms), %.2f M quadrature points/s "
+                "(%.2f M layer evaluations/s, %.2f M per thread), speed-up %.2fx\n",
+                t, 1e3 * per_step, 1e3 * forces / fs.substeps, qps / 1e6, qps * layers / 1e6,
+                qps * layers / 1e6 / t, base / per_step);
+  }
+  return 0;
+}

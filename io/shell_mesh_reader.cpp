@@ -1,0 +1,166 @@
+#include "io/shell_mesh_reader.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+#include <unordered_map>
+#include <utility>
+
+#include "io/mesh_reader.h"
+
+namespace shellmpm {
+
+namespace {
+
+using Range = std::pair<std::size_t, std::size_t>;  // [first, last) triangle
+
+/// Collects meshes like read_mesh's collector and records, per name, the triangle
+/// ranges its meshes and nodes contributed (a DFS appends each subtree contiguously).
+struct Collector {
+  const aiScene* scene;
+  ShellMesh mesh;
+  bool all_have_uvs = true;
+  std::map<std::string, std::vector<Range>> named;
+
+  void name_range(const aiString& name, std::size_t first) {
+    const std::string s = name.C_Str();
+    if (s.empty() || s == "defaultobject" || first == mesh.triangles.size()) return;
+    named[s].emplace_back(first, mesh.triangles.size());
+  }
+
+  void visit(const aiNode* node, const aiMatrix4x4& parent, bool is_root) {
+    const aiMatrix4x4 m = parent * node->mTransformation;
+    const std::size_t first = mesh.triangles.size();
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) add(scene->mMeshes[node->mMeshes[i]], m);
+    for (unsigned c = 0; c < node->mNumChildren; ++c) visit(node->mChildren[c], m, false);
+    if (!is_root || node->mNumMeshes > 0) name_range(node->mName, first);
+  }
+
+  void add(const aiMesh* am, const aiMatrix4x4& m) {
+    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) return;
+    const int offset = static_cast<int>(mesh.vertices.size());
+    const std::size_t first = mesh.triangles.size();
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      const aiVector3D p = m * am->mVertices[v];
+      mesh.vertices.emplace_back(p.x, p.y, p.z);
+    }
+    const bool uv = am->HasTextureCoords(0);
+    all_have_uvs = all_have_uvs && uv;
+    if (all_have_uvs)
+      for (unsigned v = 0; v < am->mNumVertices; ++v)
+        mesh.uvs.emplace_back(am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y);
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines
+      mesh.triangles.emplace_back(offset + static_cast<int>(face.mIndices[0]),
+                                  offset + static_cast<int>(face.mIndices[1]),
+                                  offset + static_cast<int>(face.mIndices[2]));
+    }
+    name_range(am->mName, first);
+  }
+};
+
+struct PositionKey {
+  std::uint64_t bits[3];
+  bool operator==(const PositionKey& o) const {
+    return bits[0] == o.bits[0] && bits[1] == o.bits[1] && bits[2] == o.bits[2];
+  }
+};
+
+struct PositionHash {
+  std::size_t operator()(const PositionKey& k) const {
+    std::uint64_t h = 1469598103934665603ull;
+    for (std::uint64_t b : k.bits) h = (h ^ b) * 1099511628211ull + (h >> 29);
+    return static_cast<std::size_t>(h);
+  }
+};
+
+PositionKey key_of(const Vec3d& p) {
+  PositionKey k;
+  for (int i = 0; i < 3; ++i) {
+    const double x = p[i] + 0.0;  // -0 becomes +0
+    std::memcpy(&k.bits[i], &x, sizeof x);
+  }
+  return k;
+}
+
+}  // namespace
+
+ShellMesh read_shell_mesh(const std::string& path, const std::string& where) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw detail::user_error_at(where, "mesh file '" + path + "' does not exist or is not a file");
+
+  Assimp::Importer importer;
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                         aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+  const aiScene* scene = importer.ReadFile(path, flags);
+  if (!scene || !scene->mRootNode || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
+    std::string why = importer.GetErrorString();
+    if (why.find("No meshes remaining") != std::string::npos)
+      why = "it has no triangles (only points or lines)";
+    throw detail::user_error_at(where, "cannot read mesh '" + path + "': " + why);
+  }
+
+  Collector c{scene, {}, true, {}};
+  c.visit(scene->mRootNode, aiMatrix4x4(), true);
+  ShellMesh& in = c.mesh;
+  if (!c.all_have_uvs) in.uvs.clear();
+  if (in.triangles.empty())
+    throw detail::user_error_at(where, "mesh '" + path + "' has no triangles");
+  for (std::size_t v = 0; v < in.vertices.size(); ++v)
+    if (!in.vertices[v].allFinite()) {
+      std::ostringstream os;
+      os << "mesh '" << path << "' has a non-finite coordinate at vertex " << v << " ("
+         << in.vertices[v].transpose() << ")";
+      throw detail::user_error_at(where, os.str());
+    }
+
+  // One control point per position: the first occurrence wins (and keeps its UV).
+  ShellMesh out;
+  std::vector<int> remap(in.vertices.size());
+  std::unordered_map<PositionKey, int, PositionHash> first_at;
+  first_at.reserve(in.vertices.size());
+  for (std::size_t v = 0; v < in.vertices.size(); ++v) {
+    const auto [it, inserted] =
+        first_at.emplace(key_of(in.vertices[v]), static_cast<int>(out.vertices.size()));
+    if (inserted) {
+      out.vertices.push_back(in.vertices[v]);
+      if (!in.uvs.empty()) out.uvs.push_back(in.uvs[v]);
+    }
+    remap[v] = it->second;
+  }
+  out.triangles.reserve(in.triangles.size());
+  for (std::size_t t = 0; t < in.triangles.size(); ++t) {
+    const Eigen::Vector3i f(remap[in.triangles[t][0]], remap[in.triangles[t][1]],
+                            remap[in.triangles[t][2]]);
+    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) {
+      std::ostringstream os;
+      os << "mesh '" << path << "': triangle " << t
+         << " has two corners at the same position (a shell needs one control point per "
+            "position; remove the degenerate triangle)";
+      throw detail::user_error_at(where, os.str());
+    }
+    out.triangles.push_back(f);
+  }
+
+  for (const auto& [name, ranges] : c.named) {
+    std::vector<int>& g = out.groups[name];
+    for (const Range& r : ranges)
+      for (std::size_t t = r.first; t < r.second; ++t)
+        for (int k = 0; k < 3; ++k) g.push_back(out.triangles[t][k]);
+    std::sort(g.begin(), g.end());
+    g.erase(std::unique(g.begin(), g.end()), g.end());
+  }
+  return out;
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,528 @@
+#include "sim/shell/kirchhoff_love.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <utility>
+
+#include "sim/core/check.h"
+#include "sim/core/parallel.h"
+#include "sim/shell/denting.h"
+#include "sim/shell/shell_quadrature.h"
+
+namespace shellmpm {
+namespace {
+
+constexpr std::size_t kPointGrain = 256;    // quadrature points per chunk
+constexpr std::size_t kGatherGrain = 1024;  // control points per chunk
+
+/// Mid-surface kinematics at one quadrature point (supplement sec. 1):
+/// a_a, a_ab, a_3, atilde_a = (a_1,a x a_2 + a_1 x a_2,a) / |a_1 x a_2|, and
+/// v_a = a_3,a = (I - a_3 a_3^T) atilde_a.
+template <class T>
+struct PointKinematics {
+  using V3 = Eigen::Matrix<T, 3, 1>;
+  V3 a1, a2, a11, a12, a22, a3, t1, t2, v1, v2;
+  T inv_l;
+};
+
+template <class T>
+inline void compute_kinematics(PointKinematics<T>& k) {
+  using V3 = Eigen::Matrix<T, 3, 1>;
+  const V3 n = k.a1.cross(k.a2);
+  k.inv_l = T(1) / n.norm();
+  k.a3 = n * k.inv_l;
+  k.t1 = (k.a11.cross(k.a2) + k.a1.cross(k.a12)) * k.inv_l;
+  k.t2 = (k.a12.cross(k.a2) + k.a1.cross(k.a22)) * k.inv_l;
+  k.v1 = k.t1 - k.a3 * k.a3.dot(k.t1);
+  k.v2 = k.t2 - k.a3 * k.a3.dot(k.t2);
+}
+
+/// atanh(x) / x for x in [0, 1).
+template <class T>
+inline T atanh_over_x(T x) {
+  if (x < T(1e-2)) {
+    const T x2 = x * x;
+    return T(1) + x2 * (T(1) / T(3) + x2 * (T(1) / T(5) + x2 * (T(1) / T(7))));
+  }
+  return std::atanh(x) / x;
+}
+
+/// Laminate energy density of one layer (supplement secs. 3-4) from the current metric
+/// M = [g_a . g_b] (m11, m12, m22) and Bp (row-major 2x2): C = Bp^T M Bp has eigenvalues
+/// s_a^2 and psi = mu/4 |log C|^2 + lambda/8 (log det C)^2 = mu |log s|^2 +
+/// lambda/2 (tr log s)^2. If S != nullptr writes dpsi/dM (s11, s12, s22; symmetric,
+/// dpsi = sum_ab S_ab dM_ab).
+/// log C = alpha I + beta C with beta = (log c1 - log c2) / (c1 - c2) evaluated as
+/// 2 atanh(x) / (x tr), x = (c1 - c2) / (c1 + c2), which is stable at c1 = c2, and
+/// dpsi/dC = C^-1 (mu/2 log C + lambda/4 log det C I).
+template <class T>
+inline T layer_psi(T mu, T lambda, const T* Bp, T m11, T m12, T m22, T* S) {
+  // Columns of Bp: (Bp[0], Bp[2]) and (Bp[1], Bp[3]).
+  const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
+  const T mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
+  const T mb1x = m11 * b01 + m12 * b11, mb1y = m12 * b01 + m22 * b11;
+  const T c11 = b00 * mb0x + b10 * mb0y;
+  const T c12 = b00 * mb1x + b10 * mb1y;
+  const T c22 = b01 * mb1x + b11 * mb1y;
+  const T tr = c11 + c22;
+  const T det = c11 * c22 - c12 * c12;
+  const T hd = T(0.5) * (c11 - c22);
+  const T h = std::sqrt(hd * hd + c12 * c12);
+  const T x = T(2) * h / tr;
+  const T q = atanh_over_x(x);
+  const T L = std::log(det);  // log c1 + log c2
+  const T D = T(2) * x * q;   // log c1 - log c2
+  const T psi = T(0.125) * mu * (L * L + D * D) + T(0.125) * lambda * L * L;
+  if (S) {
+    const T beta = T(2) * q / tr;
+    const T alpha = T(0.5) * (L - beta * tr);
+    const T k = (T(0.5) * mu * alpha + T(0.25) * lambda * L) / det;
+    const T d = T(0.5) * mu * beta;
+    // dpsi/dC = k adj(C) + d I
+    const T s11 = k * c22 + d, s12 = -k * c12, s22 = k * c11 + d;
+    // dpsi/dM = Bp S_C Bp^T
+    const T r00 = b00 * s11 + b01 * s12, r01 = b00 * s12 + b01 * s22;
+    const T r10 = b10 * s11 + b11 * s12, r11 = b10 * s12 + b11 * s22;
+    S[0] = r00 * b00 + r01 * b01;
+    S[1] = r00 * b10 + r01 * b11;
+    S[2] = r10 * b10 + r11 * b11;
+  }
+  return psi;
+}
+
+/// Log singular values (log s1, log s2) of the elastic block (for statistics).
+template <class T>
+inline void layer_log_s(const T* Bp, T m11, T m12, T m22, T& l1, T& l2) {
+  const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
+  const T mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
+  const T mb1x = m11 * b01 + m12 * b11, mb1y = m12 * b01 + m22 * b11;
+  const T c11 = b00 * mb0x + b10 * mb0y;
+  const T c12 = b00 * mb1x + b10 * mb1y;
+  const T c22 = b01 * mb1x + b11 * mb1y;
+  const T tr = c11 + c22;
+  const T hd = T(0.5) * (c11 - c22);
+  const T x = T(2) * std::sqrt(hd * hd + c12 * c12) / tr;
+  const T L = std::log(c11 * c22 - c12 * c12);
+  const T D = T(2) * x * atanh_over_x(x);
+  l1 = T(0.25) * (L + D);
+  l2 = T(0.25) * (L - D);
+}
+
+template <class T>
+inline void mul2(const T* A, const T* B, T* out) {  // row-major 2x2 product
+  out[0] = A[0] * B[0] + A[1] * B[2];
+  out[1] = A[0] * B[1] + A[1] * B[3];
+  out[2] = A[2] * B[0] + A[3] * B[2];
+  out[3] = A[2] * B[1] + A[3] * B[3];
+}
+
+/// Sums per-chunk partial values in chunk order (deterministic for any thread count).
+template <class Fn>
+double chunked_sum(std::size_t n, std::size_t grain, bool serial, Fn&& fn) {
+  if (n == 0) return 0.0;
+  const std::size_t chunks = (n + grain - 1) / grain;
+  std::vector<double> part(chunks, 0.0);
+  parallel_for(
+      n, grain, [&](std::size_t b, std::size_t e) { part[b / grain] = fn(b, e); }, serial);
+  double s = 0.0;
+  for (double p : part) s += p;
+  return s;
+}
+
+}  // namespace
+
+template <class T>
+KirchhoffLoveShellT<T>::KirchhoffLoveShellT(std::vector<BasisPoint> points,
+                                            std::vector<double> inplane_weights,
+                                            const std::vector<Eigen::Matrix<double, 3, 1>>& rest,
+                                            const ShellMaterialDesc& mat, int thickness_points) {
+  using V3d = Eigen::Matrix<double, 3, 1>;
+  SHELLMPM_CHECK(points.size() == inplane_weights.size(),
+                 "points " << points.size() << " weights " << inplane_weights.size());
+  SHELLMPM_CHECK(mat.youngs_modulus > 0 && mat.poisson_ratio > -1 && mat.poisson_ratio < 0.5 &&
+                     mat.thickness > 0 && mat.yield_stress >= 0,
+                 "material E " << mat.youngs_modulus << " nu " << mat.poisson_ratio << " t "
+                               << mat.thickness << " yield " << mat.yield_stress);
+  const double E = mat.youngs_modulus, nu = mat.poisson_ratio, t = mat.thickness;
+  num_ctrl_ = rest.size();
+  mu_ = T(E / (2.0 * (1.0 + nu)));
+  lambda_ = T(E * nu / (1.0 - nu * nu));  // = 2 mu lambda / (lambda + 2 mu): plane stress
+  yield_ = T(mat.yield_stress);
+  thickness_ = T(t);
+  rho_ = mat.density;
+  thickness_d_ = t;
+
+  const LineQuadrature gl = gauss_legendre(thickness_points);
+  num_layers_ = thickness_points;
+  for (int k = 0; k < num_layers_; ++k) {
+    layer_xi3_.push_back(T(0.5 * t * gl.points[k]));
+    layer_w_.push_back(T(0.5 * t * gl.weights[k]));
+  }
+
+  const std::size_t nq = points.size();
+  begin_.assign(nq + 1, 0);
+  for (std::size_t q = 0; q < nq; ++q) {
+    const BasisPoint& p = points[q];
+    const std::size_t m = p.ctrl.size();
+    SHELLMPM_CHECK(p.N.size() == m && p.N1.size() == m && p.N2.size() == m && p.N11.size() == m &&
+                       p.N12.size() == m && p.N22.size() == m,
+                   "quadrature point " << q << " has inconsistent basis arrays");
+    begin_[q + 1] = begin_[q] + m;
+  }
+  const std::size_t ne = begin_[nq];
+  ctrl_.resize(ne);
+  coef_.resize(5 * ne);
+  value_.resize(ne);
+  entry_q_.resize(ne);
+  area_.resize(nq);
+  B_.resize(4 * nq * num_layers_);
+  B0_.resize(4 * nq);
+  rest_area_ = 0.0;
+
+  for (std::size_t q = 0; q < nq; ++q) {
+    const BasisPoint& p = points[q];
+    V3d a1 = V3d::Zero(), a2 = V3d::Zero(), a11 = V3d::Zero(), a12 = V3d::Zero(), a22 = V3d::Zero();
+    for (std::size_t i = 0; i < p.ctrl.size(); ++i) {
+      const std::size_t e = begin_[q] + i;
+      const int j = p.ctrl[i];
+      SHELLMPM_CHECK(j >= 0 && std::size_t(j) < num_ctrl_, "control point "
+                                                               << j << " of quadrature point " << q
+                                                               << " out of range " << num_ctrl_);
+      ctrl_[e] = j;
+      entry_q_[e] = int(q);
+      value_[e] = T(p.N[i]);
+      coef_[5 * e + 0] = T(p.N1[i]);
+      coef_[5 * e + 1] = T(p.N2[i]);
+      coef_[5 * e + 2] = T(p.N11[i]);
+      coef_[5 * e + 3] = T(p.N12[i]);
+      coef_[5 * e + 4] = T(p.N22[i]);
+      const V3d& xj = rest[j];
+      a1 += p.N1[i] * xj;
+      a2 += p.N2[i] * xj;
+      a11 += p.N11[i] * xj;
+      a12 += p.N12[i] * xj;
+      a22 += p.N22[i] * xj;
+    }
+    PointKinematics<double> k;
+    k.a1 = a1;
+    k.a2 = a2;
+    k.a11 = a11;
+    k.a12 = a12;
+    k.a22 = a22;
+    const double jac = a1.cross(a2).norm();
+    SHELLMPM_CHECK(jac > 0 && std::isfinite(jac),
+                   "degenerate rest tangents at quadrature point " << q);
+    compute_kinematics(k);
+    area_[q] = T(inplane_weights[q] * jac);
+    rest_area_ += inplane_weights[q] * jac;
+    // B_ba = gbar^b . e_a in the orthonormal rest frame e_1 = gbar_1/|gbar_1|, e_2 = a3 x e_1.
+    auto rest_B = [&](double xi3, T* out) {
+      const V3d g1 = k.a1 + xi3 * k.v1, g2 = k.a2 + xi3 * k.v2;
+      const V3d e1 = g1.normalized();
+      const V3d e2 = k.a3.cross(e1);
+      Eigen::Matrix2d G;
+      G << g1.dot(g1), g1.dot(g2), g1.dot(g2), g2.dot(g2);
+      SHELLMPM_CHECK(G.determinant() > 0, "degenerate rest layer at quadrature point " << q);
+      const Eigen::Matrix2d Gi = G.inverse();
+      const V3d d1 = Gi(0, 0) * g1 + Gi(0, 1) * g2, d2 = Gi(1, 0) * g1 + Gi(1, 1) * g2;
+      out[0] = T(d1.dot(e1));
+      out[1] = T(d1.dot(e2));
+      out[2] = T(d2.dot(e1));
+      out[3] = T(d2.dot(e2));
+    };
+    for (int l = 0; l < num_layers_; ++l)
+      rest_B(0.5 * t * gl.points[l], &B_[4 * (q * num_layers_ + l)]);
+    rest_B(0.0, &B0_[4 * q]);
+  }
+
+  if (has_plasticity()) {
+    fp_inv_.resize(4 * nq * num_layers_);
+    reset_plastic_state();
+  }
+
+  // Gather map: counting sort of entries by control point (ascending entry order).
+  gather_begin_.assign(num_ctrl_ + 1, 0);
+  for (std::size_t e = 0; e < ne; ++e) ++gather_begin_[ctrl_[e] + 1];
+  for (std::size_t j = 0; j < num_ctrl_; ++j) gather_begin_[j + 1] += gather_begin_[j];
+  gather_.resize(ne);
+  std::vector<std::size_t> fill(gather_begin_.begin(), gather_begin_.end() - 1);
+  for (std::size_t e = 0; e < ne; ++e) gather_[fill[ctrl_[e]]++] = e;
+}
+
+template <class T>
+void KirchhoffLoveShellT<T>::reset_plastic_state() {
+  for (std::size_t i = 0; i < fp_inv_.size(); i += 4) {
+    fp_inv_[i] = T(1);
+    fp_inv_[i + 1] = T(0);
+    fp_inv_[i + 2] = T(0);
+    fp_inv_[i + 3] = T(1);
+  }
+}
+
+template <class T>
+void KirchhoffLoveShellT<T>::set_plastic_state(const std::vector<T>& state) {
+  SHELLMPM_CHECK(state.size() == fp_inv_.size(),
+                 "plastic state size " << state.size() << " expected " << fp_inv_.size());
+  fp_inv_ = state;
+}
+
+template <class T>
+void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, double& e_total,
+                                        double& e_membrane) const {
+  using V3 = Vec3T;
+  PointKinematics<T> k;
+  k.a1.setZero();
+  k.a2.setZero();
+  k.a11.setZero();
+  k.a12.setZero();
+  k.a22.setZero();
+  for (std::size_t e = begin_[q]; e < begin_[q + 1]; ++e) {
+    const V3& xj = x[ctrl_[e]];
+    const T* c = &coef_[5 * e];
+    k.a1 += c[0] * xj;
+    k.a2 += c[1] * xj;
+    k.a11 += c[2] * xj;
+    k.a12 += c[3] * xj;
+    k.a22 += c[4] * xj;
+  }
+  compute_kinematics(k);
+
+  const bool plastic = !fp_inv_.empty();
+  const T area = area_[q];
+  V3 Ga1 = V3::Zero(), Ga2 = V3::Zero(), Gv1 = V3::Zero(), Gv2 = V3::Zero();
+  T energy = 0;
+  T fp_mean[4] = {0, 0, 0, 0};
+  T wsum = 0;
+  for (int l = 0; l < num_layers_; ++l) {
+    const std::size_t ql = q * num_layers_ + l;
+    const T xi3 = layer_xi3_[l];
+    const V3 g1 = k.a1 + xi3 * k.v1, g2 = k.a2 + xi3 * k.v2;
+    const T m11 = g1.dot(g1), m12 = g1.dot(g2), m22 = g2.dot(g2);
+    const T* B = &B_[4 * ql];
+    T Bp[4];
+    if (plastic) {
+      const T* Fi = &fp_inv_[4 * ql];
+      mul2(B, Fi, Bp);
+      for (int i = 0; i < 4; ++i) fp_mean[i] += layer_w_[l] * Fi[i];
+      wsum += layer_w_[l];
+      B = Bp;
+    }
+    const T V = area * layer_w_[l];
+    T S[3];
+    energy += V * layer_psi(mu_, lambda_, B, m11, m12, m22, grad ? S : nullptr);
+    if (grad) {
+      const T s = T(2) * V;
+      const V3 dg1 = s * (S[0] * g1 + S[1] * g2);
+      const V3 dg2 = s * (S[1] * g1 + S[2] * g2);
+      Ga1 += dg1;
+      Ga2 += dg2;
+      Gv1 += xi3 * dg1;
+      Gv2 += xi3 * dg2;
+    }
+  }
+  e_total += double(energy);
+  {  // membrane diagnostic: mid-surface layer (xi3 = 0), whole thickness
+    const T* B0 = &B0_[4 * q];
+    T Bp0[4];
+    if (plastic) {
+      for (int i = 0; i < 4; ++i) fp_mean[i] /= wsum;
+      mul2(B0, fp_mean, Bp0);
+      B0 = Bp0;
+    }
+    e_membrane += double(area * thickness_ *
+                         layer_psi(mu_, lambda_, B0, k.a1.dot(k.a1), k.a1.dot(k.a2), k.a2.dot(k.a2),
+                                   static_cast<T*>(nullptr)));
+  }
+  if (!grad) return;
+
+  // Backpropagate through v_a = (I - a3 a3^T) m_a / l, l = |n|, n = a1 x a2 (sec. 1):
+  // dE/dm_a = P Gv_a / l;
+  // dE/dn = -(1/l) sum_a [(a3.t_a) P Gv_a + (a3.Gv_a) v_a + (Gv_a.v_a) a3].
+  const V3 PG1 = Gv1 - k.a3 * k.a3.dot(Gv1), PG2 = Gv2 - k.a3 * k.a3.dot(Gv2);
+  const V3 cm1 = PG1 * k.inv_l, cm2 = PG2 * k.inv_l;
+  const V3 cn = -k.inv_l * (k.a3.dot(k.t1) * PG1 + k.a3.dot(Gv1) * k.v1 + Gv1.dot(k.v1) * k.a3 +
+                            k.a3.dot(k.t2) * PG2 + k.a3.dot(Gv2) * k.v2 + Gv2.dot(k.v2) * k.a3);
+  // Cross products: c . (u x v) -> dE/du = v x c, dE/dv = c x u.
+  // m1 = a11 x a2 + a1 x a12; m2 = a12 x a2 + a1 x a22; n = a1 x a2.
+  Ga1 += k.a12.cross(cm1) + k.a22.cross(cm2) + k.a2.cross(cn);
+  Ga2 += cm1.cross(k.a11) + cm2.cross(k.a12) + cn.cross(k.a1);
+  const V3 G11 = k.a2.cross(cm1);
+  const V3 G12 = cm1.cross(k.a1) + k.a2.cross(cm2);
+  const V3 G22 = cm2.cross(k.a1);
+  for (int i = 0; i < 3; ++i) {
+    grad[i] = Ga1[i];
+    grad[3 + i] = Ga2[i];
+    grad[6 + i] = G11[i];
+    grad[9 + i] = G12[i];
+    grad[12 + i] = G22[i];
+  }
+}
+
+template <class T>
+typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec3T* x,
+                                                                       Vec3T* forces,
+                                                                       bool serial) const {
+  const std::size_t nq = area_.size();
+  // Per-point adjoints of (a_1, a_2, a_11, a_12, a_22); every entry is written below.
+  std::unique_ptr<T[]> grad(forces ? new T[15 * nq] : nullptr);
+  const std::size_t chunks = (nq + kPointGrain - 1) / kPointGrain;
+  std::vector<double> part_total(chunks, 0.0), part_mem(chunks, 0.0);
+  parallel_for(
+      nq, kPointGrain,
+      [&](std::size_t b, std::size_t e) {
+        double et = 0.0, em = 0.0;
+        for (std::size_t q = b; q < e; ++q)
+          eval_point(q, x, forces ? &grad[15 * q] : nullptr, et, em);
+        part_total[b / kPointGrain] = et;
+        part_mem[b / kPointGrain] = em;
+      },
+      serial);
+  double et = 0.0, em = 0.0;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    et += part_total[c];
+    em += part_mem[c];
+  }
+  if (forces) {
+    // Gather: dE/dx_j = sum over entries (q, j) of N1 Ga1 + N2 Ga2 + N11 G11 + N12 G12 + N22 G22.
+    parallel_for(
+        num_ctrl_, kGatherGrain,
+        [&](std::size_t b, std::size_t e) {
+          for (std::size_t j = b; j < e; ++j) {
+            Vec3T f = Vec3T::Zero();
+            for (std::size_t i = gather_begin_[j]; i < gather_begin_[j + 1]; ++i) {
+              const std::size_t en = gather_[i];
+              const T* c = &coef_[5 * en];
+              const T* G = &grad[15 * std::size_t(entry_q_[en])];
+              for (int d = 0; d < 3; ++d)
+                f[d] += c[0] * G[d] + c[1] * G[3 + d] + c[2] * G[6 + d] + c[3] * G[9 + d] +
+                        c[4] * G[12 + d];
+            }
+            forces[j] -= f;
+          }
+        },
+        serial);
+  }
+  Energy out;
+  out.total = T(et);
+  out.membrane = T(em);
+  out.bending = T(et - em);
+  return out;
+}
+
+template <class T>
+T KirchhoffLoveShellT<T>::project_plasticity(const Vec3T* x, bool serial) {
+  if (!has_plasticity()) return T(0);
+  const double work =
+      chunked_sum(area_.size(), kPointGrain, serial, [&](std::size_t b, std::size_t e) {
+        double w = 0.0;
+        for (std::size_t q = b; q < e; ++q) {
+          PointKinematics<T> k;
+          k.a1.setZero();
+          k.a2.setZero();
+          k.a11.setZero();
+          k.a12.setZero();
+          k.a22.setZero();
+          for (std::size_t en = begin_[q]; en < begin_[q + 1]; ++en) {
+            const Vec3T& xj = x[ctrl_[en]];
+            const T* c = &coef_[5 * en];
+            k.a1 += c[0] * xj;
+            k.a2 += c[1] * xj;
+            k.a11 += c[2] * xj;
+            k.a12 += c[3] * xj;
+            k.a22 += c[4] * xj;
+          }
+          compute_kinematics(k);
+          for (int l = 0; l < num_layers_; ++l) {
+            const std::size_t ql = q * num_layers_ + l;
+            const T xi3 = layer_xi3_[l];
+            const Vec3T g1 = k.a1 + xi3 * k.v1, g2 = k.a2 + xi3 * k.v2;
+            Mat2T M;
+            M << g1.dot(g1), g1.dot(g2), g1.dot(g2), g2.dot(g2);
+            T* Fi = &fp_inv_[4 * ql];
+            T Bp[4];
+            mul2(&B_[4 * ql], Fi, Bp);
+            Mat2T Bm;
+            Bm << Bp[0], Bp[1], Bp[2], Bp[3];
+            const Mat2T Ce = Bm.transpose() * M * Bm;
+            Mat2T F;
+            F << Fi[0], Fi[1], Fi[2], Fi[3];
+            const T released = denting_project_layer(mu_, lambda_, yield_, Ce, F);
+            // Below yield F is untouched, so this copy is bitwise neutral.
+            Fi[0] = F(0, 0);
+            Fi[1] = F(0, 1);
+            Fi[2] = F(1, 0);
+            Fi[3] = F(1, 1);
+            w += double(area_[q] * layer_w_[l]) * double(released);
+          }
+        }
+        return w;
+      });
+  return T(work);
+}
+
+template <class T>
+T KirchhoffLoveShellT<T>::max_strain(const Vec3T* x, bool serial) const {
+  const std::size_t nq = area_.size();
+  if (nq == 0) return T(0);
+  const std::size_t chunks = (nq + kPointGrain - 1) / kPointGrain;
+  std::vector<T> part(chunks, T(0));
+  const bool plastic = !fp_inv_.empty();
+  parallel_for(
+      nq, kPointGrain,
+      [&](std::size_t b, std::size_t e) {
+        T m = 0;
+        for (std::size_t q = b; q < e; ++q) {
+          PointKinematics<T> k;
+          k.a1.setZero();
+          k.a2.setZero();
+          k.a11.setZero();
+          k.a12.setZero();
+          k.a22.setZero();
+          for (std::size_t en = begin_[q]; en < begin_[q + 1]; ++en) {
+            const Vec3T& xj = x[ctrl_[en]];
+            const T* c = &coef_[5 * en];
+            k.a1 += c[0] * xj;
+            k.a2 += c[1] * xj;
+            k.a11 += c[2] * xj;
+            k.a12 += c[3] * xj;
+            k.a22 += c[4] * xj;
+          }
+          compute_kinematics(k);
+          for (int l = 0; l < num_layers_; ++l) {
+            const std::size_t ql = q * num_layers_ + l;
+            const T xi3 = layer_xi3_[l];
+            const Vec3T g1 = k.a1 + xi3 * k.v1, g2 = k.a2 + xi3 * k.v2;
+            const T* B = &B_[4 * ql];
+            T Bp[4];
+            if (plastic) {
+              mul2(B, &fp_inv_[4 * ql], Bp);
+              B = Bp;
+            }
+            T l1, l2;
+            layer_log_s(B, g1.dot(g1), g1.dot(g2), g2.dot(g2), l1, l2);
+            m = std::max(m, std::max(std::abs(l1), std::abs(l2)));
+          }
+        }
+        part[b / kPointGrain] = m;
+      },
+      serial);
+  return *std::max_element(part.begin(), part.end());
+}
+
+template <class T>
+std::vector<T> KirchhoffLoveShellT<T>::lumped_masses(std::size_t num_control_points) const {
+  std::vector<double> m(num_control_points, 0.0);
+  for (std::size_t q = 0; q < area_.size(); ++q)
+    for (std::size_t e = begin_[q]; e < begin_[q + 1]; ++e) {
+      const std::size_t j = std::size_t(ctrl_[e]);
+      if (j < num_control_points)
+        m[j] += rho_ * thickness_d_ * double(area_[q]) * double(value_[e]);
+    }
+  return std::vector<T>(m.begin(), m.end());
+}
+
+template class KirchhoffLoveShellT<float>;
+template class KirchhoffLoveShellT<double>;
+
+}  // namespace shellmpm

@@ -1,0 +1,146 @@
+// Kirchhoff-Love ("laminate") shell elasticity with optional denting plasticity.
+// Guo et al. 2018, supplement sections 1 (forces), 3-4 (laminate stress, QR) and 7
+// (denting); METHOD.md "Kinematics of the shell" and "Kirchhoff-Love elasticity".
+//
+// Kinematics (supplement sec. 1): at an in-plane quadrature point
+//   a_a = sum_j x_j N_j,a;  a_3 = a_1 x a_2 / |a_1 x a_2|;
+//   a_3,a = (I - a_3 a_3^T)(a_1,a x a_2 + a_1 x a_2,a) / |a_1 x a_2|;
+//   g_a = a_a + xi3 a_3,a;  g_3 = a_3;  F = sum_i g_i (x) gbar^i,
+// with gbar^i the dual basis of the rest g-bar_i at the same xi3 (rest curvature
+// included, so any rest shape is stress free).
+// Energy (sec. 3, 4): F = r_ab q_a (x) e_b + q_3 (x) e_3 in an orthonormal rest frame
+// (e_1 along gbar_1, e_3 = abar_3). Only the in-plane 2x2 block r matters: with the
+// stored plastic part, r^E = r (F^P)^-1 = U diag(s) V^T and
+//   psi = mu |log s|^2 + lambda_ps / 2 (tr log s)^2,  lambda_ps = 2 mu lambda / (lambda + 2 mu)
+// (plane stress: membrane stiffness E t / (1 - nu^2), bending E t^3 / (12 (1 - nu^2))).
+// The kernel never forms q or U: s^2 are the eigenvalues of
+// C = (r^E)^T r^E = Bp^T M Bp, with M_ab = g_a . g_b and Bp = B (F^P)^-1,
+// B_ba = gbar^b . e_a fixed at rest; log C is evaluated in closed form.
+//
+// Quadrature and volume: V_{q,k} = w_q |abar_1 x abar_2| (t/2) w_k (mid-surface area
+// times the Gauss layer thickness; the curvature shift of the volume element,
+// det(gbar) / det(abar) = 1 + O(t kappa), is NOT included, a standard thin-shell choice).
+// Layers sit at xi3 = (t/2) zeta_k with Gauss-Legendre (zeta_k, w_k).
+//
+// Membrane / bending split (diagnostic only): membrane = t sum_q w_q |abar_1 x abar_2|
+// psi(xi3 = 0), evaluated with the mid-surface rest basis and the Gauss-weighted mean of
+// the layers' plastic parts; bending = total - membrane (may be slightly negative when
+// plasticity makes layers disagree).
+//
+// Plastic state (sec. 7): per (quadrature point, layer) the inverse plastic part
+// (F^P)^-1 as a 2x2 matrix in that layer's orthonormal rest frame (e_1, e_2), identity at
+// rest. Only allocated when yield_stress > 0.
+#pragma once
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <vector>
+
+#include "sim/core/types.h"
+#include "sim/scene/scene.h"
+
+#if __has_include("sim/shell/loop_basis.h")
+#include "sim/shell/loop_basis.h"
+#else
+namespace shellmpm {
+/// Basis functions at one parametric point: values, first and second derivatives
+/// (d/dxi1, d/dxi2, d2/dxi1^2, d2/dxi1 dxi2, d2/dxi2^2) for the control points `ctrl`.
+struct BasisPoint {
+  std::vector<int> ctrl;
+  std::vector<double> N, N1, N2, N11, N12, N22;
+};
+}  // namespace shellmpm
+#endif
+
+namespace shellmpm {
+
+/// Rest data and plastic state for all quadrature points of one shell.
+/// T is the evaluation scalar (float or double); rest data is computed in double.
+template <class T>
+class KirchhoffLoveShellT {
+ public:
+  using Vec3T = Eigen::Matrix<T, 3, 1>;
+  using Mat2T = Eigen::Matrix<T, 2, 2>;
+
+  /// points: one BasisPoint per in-plane quadrature point; inplane_weights: their
+  /// parametric weights (sum 1/2 per triangle; the area factor |abar_1 x abar_2| is
+  /// computed here from `rest`); rest: control point rest positions [m];
+  /// thickness_points: Gauss points through the thickness (1..5).
+  /// Throws InvariantError on inconsistent sizes, bad indices or a degenerate rest tangent.
+  KirchhoffLoveShellT(std::vector<BasisPoint> points, std::vector<double> inplane_weights,
+                      const std::vector<Eigen::Matrix<double, 3, 1>>& rest,
+                      const ShellMaterialDesc& mat, int thickness_points);
+
+  struct Energy {
+    T membrane, bending, total;  ///< [J]
+  };
+
+  /// Elastic energy [J] at control positions x (num_control_points() entries). If
+  /// forces != nullptr, adds -dE/dx_j [N] into forces[j] (exact gradient of the discrete
+  /// energy). Results are bitwise independent of the thread count (fixed chunks, sums in
+  /// chunk order, forces gathered per control point in a fixed order); serial = no threads.
+  Energy energy(const Vec3T* x, Vec3T* forces, bool serial = false) const;
+
+  /// Denting return mapping (supplement sec. 7) for every quadrature point and layer at
+  /// positions x; updates the stored plastic state. Returns the plastic work dissipated
+  /// in this call [J] = sum V (psi_trial - psi_projected) >= 0. No-op (returns 0) when
+  /// yield_stress == 0; a layer below yield is left bitwise unchanged.
+  T project_plasticity(const Vec3T* x, bool serial = false);
+
+  /// Largest |log s_a| (principal elastic Hencky strain, either sign) over all
+  /// quadrature points and layers.
+  T max_strain(const Vec3T* x, bool serial = false) const;
+
+  /// Lumped masses sum_q rho t w_q |abar_1 x abar_2| N_j [kg] for control points
+  /// 0..num_control_points-1 (control points outside every support get 0).
+  std::vector<T> lumped_masses(std::size_t num_control_points) const;
+
+  /// Plastic state: 4 values per (quadrature point, layer), layer fastest, each the
+  /// row-major 2x2 (F^P)^-1 in the layer's rest frame. Empty when yield_stress == 0.
+  const std::vector<T>& plastic_state() const { return fp_inv_; }
+  /// Restores a state from plastic_state() (bitwise). Size must match.
+  void set_plastic_state(const std::vector<T>& state);
+  /// Resets every layer to F^P = I.
+  void reset_plastic_state();
+
+  std::size_t num_quadrature_points() const { return area_.size(); }
+  int num_layers() const { return num_layers_; }
+  std::size_t num_control_points() const { return num_ctrl_; }
+  bool has_plasticity() const { return yield_ > 0; }
+  T mu() const { return mu_; }
+  T lambda_plane_stress() const { return lambda_; }
+  /// Rest area of the shell sum_q w_q |abar_1 x abar_2| [m^2].
+  double rest_area() const { return rest_area_; }
+
+ private:
+  // Per quadrature point: adjoints of (a_1, a_2, a_11, a_12, a_22) in `grad`
+  // (15 values); returns energy and membrane energy.
+  void eval_point(std::size_t q, const Vec3T* x, T* grad, double& e_total,
+                  double& e_membrane) const;
+
+  std::size_t num_ctrl_ = 0;
+  int num_layers_ = 0;
+  T mu_ = 0, lambda_ = 0, yield_ = 0, thickness_ = 0;
+  double rho_ = 0, thickness_d_ = 0, rest_area_ = 0;
+  std::vector<std::size_t> begin_;      // entries of quadrature point q: [begin_[q], begin_[q+1])
+  std::vector<int> ctrl_;               // control point of each entry
+  std::vector<T> coef_;                 // 5 per entry: N1, N2, N11, N12, N22
+  std::vector<T> value_;                // N per entry (masses)
+  std::vector<T> area_;                 // w_q |abar_1 x abar_2| per point
+  std::vector<T> layer_xi3_, layer_w_;  // xi3 = (t/2) zeta_k, (t/2) w_k
+  std::vector<T> B_;                    // 4 per (q, layer), row-major B
+  std::vector<T> B0_;                   // 4 per q: mid-surface B
+  std::vector<T> fp_inv_;               // 4 per (q, layer) (empty without plasticity)
+  // Gather map for forces: entries touching control point j are
+  // gather_[gather_begin_[j] .. gather_begin_[j+1]) in ascending entry order.
+  std::vector<std::size_t> gather_begin_;
+  std::vector<std::size_t> gather_;
+  std::vector<int> entry_q_;  // quadrature point of each entry
+};
+
+using KirchhoffLoveShell = KirchhoffLoveShellT<Real>;
+
+extern template class KirchhoffLoveShellT<float>;
+extern template class KirchhoffLoveShellT<double>;
+
+}  // namespace shellmpm

@@ -1,0 +1,35 @@
+// The mesh a shell writes: its Loop limit surface sampled on the control triangles,
+// each refined into 4^levels sub-triangles. Vertex count and order are fixed at setup,
+// so every frame has the same layout; positions and normals are sparse linear maps of
+// the control points, precomputed once.
+#pragma once
+#include <vector>
+
+#include "sim/core/types.h"
+#include "sim/shell/loop_basis.h"
+
+namespace shellmpm {
+
+class LimitMesh {
+ public:
+  /// uvs: per control vertex (may be empty); interpolated linearly within each face.
+  LimitMesh(const LoopBasis& basis, const std::vector<Eigen::Vector3i>& triangles,
+            const std::vector<Eigen::Vector2d>& uvs, int levels);
+
+  std::size_t num_vertices() const { return rows_.size(); }
+  const std::vector<Eigen::Vector3i>& triangles() const { return tris_; }
+  const std::vector<Eigen::Vector2d>& uvs() const { return uvs_; }
+  /// Limit positions and unit normals of the output vertices for control points x.
+  void evaluate(const Vec3* x, std::vector<Vec3>& pos, std::vector<Vec3>& normal) const;
+
+ private:
+  struct Row {
+    std::vector<int> ctrl;
+    std::vector<Real> n, d1, d2;
+  };
+  std::vector<Row> rows_;
+  std::vector<Eigen::Vector3i> tris_;
+  std::vector<Eigen::Vector2d> uvs_;
+};
+
+}  // namespace shellmpm

@@ -1,0 +1,179 @@
+#include "sim/shell/shell_object.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "sim/collider/collider.h"
+#include "sim/core/check.h"
+#include "sim/core/parallel.h"
+#include "sim/shell/procedural_mesh.h"
+#include "sim/shell/shell_quadrature.h"
+
+namespace shellmpm {
+
+ShellMesh build_shell_rest_mesh(const ShellDesc& d) {
+  ShellMesh m;
+  switch (d.kind) {
+    case ShellDesc::Kind::Sheet:
+      m = make_sheet(d.size[0], d.size[1], d.resolution[0], d.resolution[1]);
+      break;
+    case ShellDesc::Kind::Cylinder:
+      m = make_cylinder(d.radius, d.height, d.angle_deg, d.resolution[0], d.resolution[1]);
+      break;
+    case ShellDesc::Kind::Sphere:
+      m = make_sphere(d.radius, d.subdivisions);
+      break;
+    case ShellDesc::Kind::Mesh:
+      SHELLMPM_CHECK(d.mesh != nullptr, << "shell mesh not loaded: " << d.mesh_path);
+      m = *d.mesh;
+      break;
+  }
+  const Vec3d r = d.rotate_deg * (M_PI / 180.0);
+  const Mat3d R = (Eigen::AngleAxisd(r.z(), Vec3d::UnitZ()) * Eigen::AngleAxisd(r.y(), Vec3d::UnitY()) *
+                   Eigen::AngleAxisd(r.x(), Vec3d::UnitX()))
+                      .toRotationMatrix();
+  for (Vec3d& p : m.vertices) p = R * (d.scale * p) + d.translate;
+  return m;
+}
+
+ShellObject::ShellObject(const ShellDesc& desc, const ShellMaterialDesc& mat, ShellMesh rest_mesh)
+    : desc_(desc), mat_(mat) {
+  tris_ = rest_mesh.triangles;
+  rest = rest_mesh.vertices;
+  const int nv = static_cast<int>(rest.size());
+  basis_ = std::make_unique<LoopBasis>(nv, tris_);
+  // Quadrature points: every face with the in-plane rule.
+  const TriangleQuadrature rule = triangle_quadrature(mat.quadrature_inplane);
+  std::vector<BasisPoint> pts;
+  std::vector<double> weights;
+  pts.reserve(tris_.size() * rule.points.size());
+  for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
+    for (std::size_t q = 0; q < rule.points.size(); ++q) {
+      BasisPoint bp;
+      basis_->evaluate(f, rule.points[q].x(), rule.points[q].y(), bp);
+      pts.push_back(std::move(bp));
+      weights.push_back(rule.weights[q]);
+    }
+  kl_ = std::make_unique<KirchhoffLoveShell>(std::move(pts), std::move(weights), rest, mat,
+                                             mat.quadrature_thickness);
+  limit_ = std::make_unique<LimitMesh>(*basis_, tris_, rest_mesh.uvs, desc.output_refine);
+  mass = kl_->lumped_masses(rest.size());
+  x.resize(nv);
+  v.assign(nv, desc.velocity.cast<Real>());
+  for (int i = 0; i < nv; ++i) x[i] = rest[i].cast<Real>();
+  // Pins.
+  pin_mask.assign(nv, 0);
+  pin_of.assign(nv, -1);
+  for (int p = 0; p < static_cast<int>(desc.pins.size()); ++p) {
+    const PinDesc& pin = desc.pins[p];
+    std::uint8_t mask = 0;
+    for (int a = 0; a < 3; ++a) mask |= pin.components[a] ? (1u << a) : 0u;
+    auto hold = [&](int i) {
+      SHELLMPM_CHECK(i >= 0 && i < nv, << "pin index " << i << " of " << nv);
+      pin_mask[i] |= mask;
+      pin_of[i] = p;
+    };
+    for (int i : pin.indices) hold(i);
+    if (pin.has_box)
+      for (int i = 0; i < nv; ++i)
+        if ((rest[i].array() >= pin.box_min.array()).all() &&
+            (rest[i].array() <= pin.box_max.array()).all())
+          hold(i);
+    if (!pin.group.empty()) {
+      const auto it = rest_mesh.groups.find(pin.group);
+      SHELLMPM_CHECK(it != rest_mesh.groups.end(), << "vertex group " << pin.group);
+      for (int i : it->second) hold(i);
+    }
+  }
+  for (int i = 0; i < nv; ++i)
+    if (pin_mask[i]) v[i].setZero();
+  min_edge_ = 1e300;
+  for (const auto& t : tris_)
+    for (int e = 0; e < 3; ++e)
+      min_edge_ = std::min(min_edge_, (rest[t[e]] - rest[t[(e + 1) % 3]]).norm());
+}
+
+KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector<Vec3>& f,
+                                               bool serial) const {
+  const std::size_t n = x.size();
+  f.assign(n, Vec3::Zero());
+  const KirchhoffLoveShell::Energy e = kl_->energy(x.data(), f.data(), serial);
+  if (mat_.stiffness_damping > 0) {
+    // Rayleigh stiffness damping -beta K v, with K v from the directional derivative of
+    // the elastic force: f(x + eps v) - f(x) = -eps K v + O(eps^2).
+    const Real eps = Real(1e-4);
+    std::vector<Vec3> xs(n), f2(n, Vec3::Zero()), f1(n, Vec3::Zero());
+    for (std::size_t i = 0; i < n; ++i) xs[i] = x[i] + eps * v[i];
+    kl_->energy(x.data(), f1.data(), serial);
+    kl_->energy(xs.data(), f2.data(), serial);
+    const Real c = static_cast<Real>(mat_.stiffness_damping) / eps;
+    for (std::size_t i = 0; i < n; ++i) f[i] += c * (f2[i] - f1[i]);
+  }
+  const Vec3 g = gravity.cast<Real>();
+  for (std::size_t i = 0; i < n; ++i) f[i] += mass[i] * g;
+  if (desc_.pressure != 0) {
+    // Pressure on the control mesh: p * area * normal, a third to each corner.
+    for (const auto& t : tris_) {
+      const Vec3 an = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);  // 2 * area * n
+      const Vec3 fc = (static_cast<Real>(desc_.pressure) / Real(6)) * an;
+      for (int c = 0; c < 3; ++c) f[t[c]] += fc;
+    }
+  }
+  for (const PointLoadDesc& pl : desc_.point_loads) f[pl.index] += pl.force.cast<Real>();
+  return e;
+}
+
+void ShellObject::integrate(const std::vector<Vec3>& f, double t, double dt, bool serial) {
+  const Real h = static_cast<Real>(dt);
+  const Real damp = Real(1) / Real(1 + dt * mat_.damping);
+  std::vector<RigidPose> poses(desc_.pins.size());
+  std::vector<char> released(desc_.pins.size());
+  for (std::size_t p = 0; p < poses.size(); ++p) {
+    poses[p] = keyframe_pose(desc_.pins[p].keyframes, t + dt);
+    released[p] = desc_.pins[p].release_time >= 0 && t >= desc_.pins[p].release_time;
+  }
+  parallel_for(
+      x.size(), 4096,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          if (mass[i] > 0) v[i] = damp * (v[i] + (h / mass[i]) * f[i]);
+          if (pin_mask[i] && !released[pin_of[i]]) {
+            const Vec3 target = poses[pin_of[i]].apply(rest[i]).cast<Real>();
+            for (int a = 0; a < 3; ++a)
+              if (pin_mask[i] & (1u << a)) v[i][a] = (target[a] - x[i][a]) / h;
+          }
+          x[i] += h * v[i];
+        }
+      },
+      serial);
+}
+
+double ShellObject::project_plasticity(bool serial) {
+  if (!has_denting()) return 0.0;
+  return static_cast<double>(kl_->project_plasticity(x.data(), serial));
+}
+
+double ShellObject::stable_dt(double cfl) const {
+  const double E = mat_.youngs_modulus, nu = mat_.poisson_ratio, rho = mat_.density;
+  const double c = std::sqrt(E / (rho * (1 - nu * nu)));  // membrane wave speed
+  const double kappa = c * mat_.thickness / std::sqrt(12.0);  // bending: omega = kappa k^2
+  const double h = min_edge_;
+  double dt = cfl * h / c;
+  dt = std::min(dt, cfl * h * h / (4.0 * kappa));
+  if (mat_.stiffness_damping > 0) {
+    // Central difference with damping ratio xi = beta omega / 2 at the highest frequency
+    // omega = 2 / dt is stable for dt <= (2 / omega)(sqrt(1 + xi^2) - xi).
+    const double xi = mat_.stiffness_damping / dt;
+    dt *= std::sqrt(1 + xi * xi) - xi;
+  }
+  return dt;
+}
+
+double ShellObject::kinetic_energy() const {
+  double k = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) k += 0.5 * mass[i] * v[i].squaredNorm();
+  return k;
+}
+
+}  // namespace shellmpm

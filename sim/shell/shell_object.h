@@ -1,0 +1,68 @@
+// One shell in a scene: its control points (SoA), Kirchhoff-Love quadrature data,
+// pins, loads, and the limit mesh it writes. Shell-only scenes integrate the control
+// points directly (symplectic Euler, no grid); with contact (issue 4) the same forces
+// go through the MPM grid.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/core/types.h"
+#include "sim/scene/scene.h"
+#include "sim/shell/kirchhoff_love.h"
+#include "sim/shell/limit_mesh.h"
+#include "sim/shell/loop_basis.h"
+
+namespace shellmpm {
+
+/// Builds the rest control mesh of a shell: procedural or `desc.mesh`, then placed
+/// with scale, rotation and translation.
+ShellMesh build_shell_rest_mesh(const ShellDesc& desc);
+
+class ShellObject {
+ public:
+  ShellObject(const ShellDesc& desc, const ShellMaterialDesc& mat, ShellMesh rest);
+
+  const std::string& name() const { return desc_.name; }
+  std::size_t size() const { return x.size(); }
+
+  /// Internal (elastic) forces plus gravity, pressure and point loads into `f`
+  /// (resized); returns the elastic energy split.
+  KirchhoffLoveShell::Energy forces(const Vec3d& gravity, std::vector<Vec3>& f,
+                                    bool serial) const;
+  /// One symplectic Euler step with the forces f: damping, pins at time t + dt.
+  void integrate(const std::vector<Vec3>& f, double t, double dt, bool serial);
+  /// Denting return mapping; returns plastic work [J]. No-op without a yield stress.
+  double project_plasticity(bool serial);
+  bool has_denting() const { return mat_.yield_stress > 0; }
+  /// The largest stable explicit step for this shell's membrane and bending stiffness [s].
+  double stable_dt(double cfl) const;
+  /// Kinetic energy [J].
+  double kinetic_energy() const;
+  double max_strain() const { return static_cast<double>(kl_->max_strain(x.data())); }
+  /// The output mesh for the current state.
+  void output_mesh(std::vector<Vec3>& pos, std::vector<Vec3>& normal) const {
+    limit_->evaluate(x.data(), pos, normal);
+  }
+  const LimitMesh& limit_mesh() const { return *limit_; }
+  const ShellDesc& desc() const { return desc_; }
+  KirchhoffLoveShell& kl() { return *kl_; }
+  const KirchhoffLoveShell& kl() const { return *kl_; }
+
+  std::vector<Vec3> x, v;          ///< control point positions and velocities
+  std::vector<Real> mass;          ///< lumped masses [kg]
+  std::vector<Vec3d> rest;         ///< rest positions
+  std::vector<std::uint8_t> pin_mask;  ///< bit a: component a is held
+  std::vector<int> pin_of;         ///< which pin holds the point (-1: none)
+
+ private:
+  ShellDesc desc_;
+  ShellMaterialDesc mat_;
+  std::vector<Eigen::Vector3i> tris_;
+  std::unique_ptr<LoopBasis> basis_;
+  std::unique_ptr<KirchhoffLoveShell> kl_;
+  std::unique_ptr<LimitMesh> limit_;
+  double min_edge_ = 0;
+};
+
+}  // namespace shellmpm

@@ -1,0 +1,387 @@
+// Tests for denting (supplement sec. 7): the slope +-1 return mapping, the per-layer
+// plastic update, and permanent dents of a Kirchhoff-Love shell.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <random>
+#include <vector>
+
+#include "sim/core/parallel.h"
+#include "sim/shell/denting.h"
+#include "sim/shell/kirchhoff_love.h"
+#include "sim/shell/shell_quadrature.h"
+
+namespace {
+
+// Test basis: a grid of m x m squares over [0,1]^2, each split into two Bezier
+// (Bernstein) triangles of degree n; shared edge nodes are shared control points.
+// Bernstein triangles reproduce linear fields and give exact derivatives.
+struct BezierShell {
+  std::vector<shellmpm::BasisPoint> points;
+  std::vector<double> weights;
+  std::vector<Eigen::Vector2d> node_uv;       // domain coordinates of control points
+  std::vector<std::vector<int>> patch_nodes;  // per triangle, local node -> control id
+  std::vector<Eigen::Vector2d> patch_corner;  // per triangle: P0, P1, P2 (3 entries each)
+  int degree = 0;
+};
+
+inline double bern_pow(double x, int e) {
+  return e < 0 ? 0.0 : std::pow(x, e);
+}
+
+// Values and derivatives of xi1^i xi2^j w^k (w = 1 - xi1 - xi2) times c.
+inline void bern_eval(int i, int j, int k, double c, double x1, double x2, double out[6]) {
+  const double w = 1.0 - x1 - x2;
+  auto P = [&](int a, int b, int d) {
+    if (a < 0 || b < 0 || d < 0) return 0.0;
+    return bern_pow(x1, a) * bern_pow(x2, b) * bern_pow(w, d);
+  };
+  out[0] = c * P(i, j, k);
+  out[1] = c * (i * P(i - 1, j, k) - k * P(i, j, k - 1));
+  out[2] = c * (j * P(i, j - 1, k) - k * P(i, j, k - 1));
+  out[3] = c * (i * (i - 1) * P(i - 2, j, k) - 2.0 * i * k * P(i - 1, j, k - 1) +
+                k * (k - 1) * P(i, j, k - 2));
+  out[4] = c * (i * j * P(i - 1, j - 1, k) - i * k * P(i - 1, j, k - 1) -
+                j * k * P(i, j - 1, k - 1) + k * (k - 1) * P(i, j, k - 2));
+  out[5] = c * (j * (j - 1) * P(i, j - 2, k) - 2.0 * j * k * P(i, j - 1, k - 1) +
+                k * (k - 1) * P(i, j, k - 2));
+}
+
+inline double factorial(int n) {
+  return n <= 1 ? 1.0 : n * factorial(n - 1);
+}
+
+inline BezierShell make_bezier_grid(int m, int n, int qrule) {
+  BezierShell s;
+  s.degree = n;
+  const int R = n * m;  // lattice resolution
+  std::map<std::pair<int, int>, int> id;
+  auto node = [&](int a, int b) {
+    auto it = id.find({a, b});
+    if (it != id.end()) return it->second;
+    const int k = int(s.node_uv.size());
+    id[{a, b}] = k;
+    s.node_uv.emplace_back(double(a) / R, double(b) / R);
+    return k;
+  };
+  const shellmpm::TriangleQuadrature tq = shellmpm::triangle_quadrature(qrule);
+  for (int bx = 0; bx < m; ++bx)
+    for (int by = 0; by < m; ++by)
+      for (int half = 0; half < 2; ++half) {
+        Eigen::Vector2i P0, P1, P2;
+        if (half == 0) {
+          P0 = {bx, by};
+          P1 = {bx + 1, by};
+          P2 = {bx, by + 1};
+        } else {
+          P0 = {bx + 1, by + 1};
+          P1 = {bx, by + 1};
+          P2 = {bx + 1, by};
+        }
+        std::vector<int> local;  // ordered by (i, j)
+        std::vector<Eigen::Vector3i> ijk;
+        for (int i = 0; i <= n; ++i)
+          for (int j = 0; i + j <= n; ++j) {
+            const Eigen::Vector2i L = n * P0 + i * (P1 - P0) + j * (P2 - P0);
+            local.push_back(node(L.x(), L.y()));
+            ijk.emplace_back(i, j, n - i - j);
+          }
+        s.patch_nodes.push_back(local);
+        s.patch_corner.push_back(P0.cast<double>() / m);
+        s.patch_corner.push_back(P1.cast<double>() / m);
+        s.patch_corner.push_back(P2.cast<double>() / m);
+        for (std::size_t g = 0; g < tq.points.size(); ++g) {
+          shellmpm::BasisPoint bp;
+          for (std::size_t a = 0; a < local.size(); ++a) {
+            const int i = ijk[a].x(), j = ijk[a].y(), k = ijk[a].z();
+            const double c = factorial(n) / (factorial(i) * factorial(j) * factorial(k));
+            double v[6];
+            bern_eval(i, j, k, c, tq.points[g].x(), tq.points[g].y(), v);
+            bp.ctrl.push_back(local[a]);
+            bp.N.push_back(v[0]);
+            bp.N1.push_back(v[1]);
+            bp.N2.push_back(v[2]);
+            bp.N11.push_back(v[3]);
+            bp.N12.push_back(v[4]);
+            bp.N22.push_back(v[5]);
+          }
+          s.points.push_back(bp);
+          s.weights.push_back(tq.weights[g]);
+        }
+      }
+  return s;
+}
+
+// Control points interpolating phi(u, v) at the lattice nodes of each patch.
+inline std::vector<Eigen::Vector3d> interpolate(
+    const BezierShell& s, const std::function<Eigen::Vector3d(const Eigen::Vector2d&)>& phi) {
+  std::vector<Eigen::Vector3d> x(s.node_uv.size(), Eigen::Vector3d::Zero());
+  const int n = s.degree;
+  for (std::size_t p = 0; p < s.patch_nodes.size(); ++p) {
+    const auto& local = s.patch_nodes[p];
+    const int nn = int(local.size());
+    Eigen::MatrixXd A(nn, nn);
+    Eigen::MatrixXd rhs(nn, 3);
+    int r = 0;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j, ++r) {
+        const double x1 = double(i) / n, x2 = double(j) / n;
+        int c = 0;
+        for (int a = 0; a <= n; ++a)
+          for (int b = 0; a + b <= n; ++b, ++c) {
+            const int k = n - a - b;
+            double v[6];
+            bern_eval(a, b, k, factorial(n) / (factorial(a) * factorial(b) * factorial(k)), x1, x2,
+                      v);
+            A(r, c) = v[0];
+          }
+        rhs.row(r) = phi(s.node_uv[local[r]]).transpose();
+      }
+    const Eigen::MatrixXd sol = A.partialPivLu().solve(rhs);
+    for (int a = 0; a < nn; ++a) x[local[a]] = sol.row(a).transpose();
+  }
+  return x;
+}
+
+using Shell = shellmpm::KirchhoffLoveShellT<double>;
+using V3 = Eigen::Vector3d;
+using V2 = Eigen::Vector2d;
+
+constexpr double kMu = 3.0e5, kLambda = 2.0e5, kYield = 1.0e3;
+
+shellmpm::ShellMaterialDesc dent_material(double yield) {
+  shellmpm::ShellMaterialDesc m;
+  m.youngs_modulus = 1e6;
+  m.poisson_ratio = 0.3;
+  m.density = 1000;
+  m.thickness = 0.01;
+  m.yield_stress = yield;
+  return m;
+}
+
+V3 cylinder(const V2& uv, double kappa) {
+  if (kappa == 0) return V3(uv.x(), uv.y(), 0);
+  const double R = 1 / kappa;
+  return V3(R * std::sin(uv.x() / R), uv.y(), R * (1 - std::cos(uv.x() / R)));
+}
+
+std::vector<V3> bent(const BezierShell& s, double kappa) {
+  return interpolate(s, [kappa](const V2& uv) { return cylinder(uv, kappa); });
+}
+
+double energy_of(const Shell& sh, const std::vector<V3>& x) {
+  return sh.energy(x.data(), nullptr).total;
+}
+
+// Forces vs. central differences along random directions; the error must fall as eps^2.
+void check_fd(const Shell& sh, const std::vector<V3>& x, std::mt19937& rng) {
+  std::normal_distribution<double> nd(0.0, 1.0);
+  std::vector<V3> f(x.size(), V3::Zero());
+  sh.energy(x.data(), f.data());
+  for (int trial = 0; trial < 3; ++trial) {
+    std::vector<V3> dir(x.size());
+    for (V3& d : dir) d = V3(nd(rng), nd(rng), nd(rng));
+    double a = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) a -= f[i].dot(dir[i]);
+    auto err = [&](double eps) {
+      std::vector<V3> xp = x, xm = x;
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        xp[i] += eps * dir[i];
+        xm[i] -= eps * dir[i];
+      }
+      return std::abs((energy_of(sh, xp) - energy_of(sh, xm)) / (2 * eps) - a);
+    };
+    const double e4 = err(1e-4), e5 = err(1e-5);
+    INFO("analytic " << a << " err(1e-4) " << e4 << " err(1e-5) " << e5);
+    CHECK(std::abs(a) > 0);
+    CHECK((e5 < 0.05 * e4 || e5 < 1e-9 * std::abs(a)));
+    CHECK(e4 < 1e-3 * std::abs(a));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("denting return map: feasible states untouched, others onto the boundary", "[denting]") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.006, 0.006);
+  int projected = 0, kept = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const V2 l0(u(rng), u(rng));
+    V2 l = l0;
+    const V2 tau0 = shellmpm::denting_principal_stress(kMu, kLambda, l0);
+    const double f0 = shellmpm::denting_yield_function(tau0(0), tau0(1), kYield);
+    const bool yielded = shellmpm::denting_return_map(kMu, kLambda, kYield, l);
+    CHECK(yielded == (f0 > 0));
+    if (!yielded) {
+      ++kept;
+      CHECK(l(0) == l0(0));  // bitwise
+      CHECK(l(1) == l0(1));
+      continue;
+    }
+    ++projected;
+    const V2 tau = shellmpm::denting_principal_stress(kMu, kLambda, l);
+    // On the boundary of the slope +-1 region.
+    CHECK(std::abs(shellmpm::denting_yield_function(tau(0), tau(1), kYield)) < 1e-12);
+    // Released energy is non-negative.
+    CHECK(shellmpm::denting_energy_density(kMu, kLambda, l) <=
+          shellmpm::denting_energy_density(kMu, kLambda, l0));
+    // Perpendicular return = closest feasible point: no sampled feasible point is closer.
+    const double dist = (tau0 - tau).norm();
+    for (int k = 0; k < 50; ++k) {
+      const V2 other(u(rng) * 2e5, u(rng) * 2e5);
+      if (shellmpm::denting_yield_function(other(0), other(1), kYield) <= 0)
+        CHECK(dist <= (tau0 - other).norm() + 1e-9);
+    }
+    // Idempotent (a second projection moves the state by round-off at most).
+    V2 again = l;
+    shellmpm::denting_return_map(kMu, kLambda, kYield, again);
+    CHECK((again - l).norm() < 1e-15);
+  }
+  CHECK(projected > 100);
+  CHECK(kept > 100);
+  // Uniaxial yield at sigma_y, equi-biaxial yield at sigma_y, pure shear at sigma_y/sqrt(3).
+  CHECK(shellmpm::denting_yield_function(kYield, 0.0, kYield) <= 1e-15);
+  CHECK(shellmpm::denting_yield_function(kYield, kYield, kYield) == Approx(0.0).margin(1e-15));
+  CHECK(shellmpm::denting_yield_function(kYield / std::sqrt(3.0), -kYield / std::sqrt(3.0),
+                                         kYield) == Approx(0.0).margin(1e-15));
+}
+
+TEST_CASE("denting layer projection keeps principal directions and lands on yield", "[denting]") {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 200; ++i) {
+    Eigen::Matrix2d r;  // in-plane block of F
+    r << 1 + 0.02 * u(rng), 0.02 * u(rng), 0.0, 1 + 0.02 * u(rng);
+    Eigen::Matrix2d fp_inv;
+    fp_inv << 1 + 0.003 * u(rng), 0.003 * u(rng), 0.003 * u(rng), 1 + 0.003 * u(rng);
+    const Eigen::Matrix2d fp_old = fp_inv;
+    const Eigen::Matrix2d re = r * fp_inv;  // trial elastic block
+    const Eigen::Matrix2d Ce = re.transpose() * re;
+    bool yielded = false;
+    const double released =
+        shellmpm::denting_project_layer(kMu, kLambda, kYield, Ce, fp_inv, &yielded);
+    CHECK(released >= 0);
+    const Eigen::Matrix2d re_new = r * fp_inv;
+    const Eigen::JacobiSVD<Eigen::Matrix2d> svd(re_new);
+    const V2 l(std::log(svd.singularValues()(0)), std::log(svd.singularValues()(1)));
+    const V2 tau = shellmpm::denting_principal_stress(kMu, kLambda, l);
+    const double f = shellmpm::denting_yield_function(tau(0), tau(1), kYield);
+    if (!yielded) {
+      CHECK(released == 0);
+      CHECK(fp_inv == fp_old);
+      CHECK(f <= 0);
+      continue;
+    }
+    CHECK(std::abs(f) < 1e-8);
+    // Same V: the new elastic Cauchy-Green commutes with the trial one.
+    const Eigen::Matrix2d Cn = re_new.transpose() * re_new;
+    CHECK((Cn * Ce - Ce * Cn).norm() < 1e-12);
+    // Released energy = psi(trial) - psi(projected).
+    const Eigen::JacobiSVD<Eigen::Matrix2d> svd0(re);
+    const V2 l0(std::log(svd0.singularValues()(0)), std::log(svd0.singularValues()(1)));
+    CHECK(released == Approx(shellmpm::denting_energy_density(kMu, kLambda, l0) -
+                             shellmpm::denting_energy_density(kMu, kLambda, l))
+                          .epsilon(1e-6));
+  }
+}
+
+TEST_CASE("denting: loading below yield and unloading leaves no plastic strain", "[denting]") {
+  const BezierShell s = make_bezier_grid(2, 5, 6);
+  const std::vector<V3> flat = bent(s, 0.0);
+  Shell sh(s.points, s.weights, flat, dent_material(1.5e3), 3);
+  REQUIRE(sh.has_plasticity());
+  const std::vector<double> before = sh.plastic_state();
+  for (double kappa : {0.05, 0.1, 0.05}) {
+    const std::vector<V3> x = bent(s, kappa);
+    CHECK(sh.project_plasticity(x.data()) == 0.0);
+  }
+  CHECK(sh.plastic_state() == before);  // bitwise
+  CHECK(energy_of(sh, flat) < 1e-20);
+  // Without a yield stress the call is a no-op.
+  Shell elastic(s.points, s.weights, flat, dent_material(0.0), 3);
+  const std::vector<V3> x = bent(s, 2.0);
+  CHECK(elastic.project_plasticity(x.data()) == 0.0);
+  CHECK(elastic.plastic_state().empty());
+}
+
+TEST_CASE("denting: bending beyond yield leaves a permanent curvature", "[denting]") {
+  std::mt19937 rng(21);
+  const BezierShell s = make_bezier_grid(2, 5, 6);
+  const std::vector<V3> flat = bent(s, 0.0);
+  Shell sh(s.points, s.weights, flat, dent_material(1.5e3), 3);
+  const double kmax = 1.0;
+  double work = 0;
+  for (int step = 1; step <= 10; ++step) {  // load gradually
+    const std::vector<V3> x = bent(s, kmax * step / 10.0);
+    const double w = sh.project_plasticity(x.data());
+    CHECK(w >= 0);
+    work += w;
+  }
+  CHECK(work > 0);
+  const std::vector<V3> loaded = bent(s, kmax);
+  const double e_loaded = energy_of(sh, loaded);
+  // Projected states are feasible: projecting again at the same state does nothing
+  // (up to round-off of the stored state).
+  const double again = sh.project_plasticity(loaded.data());
+  CHECK(again <= 1e-9 * e_loaded);
+  // Unloaded to the original flat state: stressed (energy > 0).
+  const double e_flat = energy_of(sh, flat);
+  CHECK(e_flat > 0.05 * e_loaded);
+  // The stress-free curvature is nonzero: the energy along the cylinder family has its
+  // minimum strictly between 0 and kmax.
+  double best_k = 0, best_e = e_flat;
+  for (int i = 1; i <= 40; ++i) {
+    const double k = kmax * i / 40.0;
+    const double e = energy_of(sh, bent(s, k));
+    if (e < best_e) {
+      best_e = e;
+      best_k = k;
+    }
+  }
+  INFO("stress-free curvature " << best_k << " energy there " << best_e << " flat " << e_flat);
+  CHECK(best_k > 0.1 * kmax);
+  CHECK(best_k < kmax);
+  CHECK(best_e < 0.2 * e_flat);
+  // Forces stay the exact gradient with an active plastic state.
+  std::uniform_real_distribution<double> u(-0.02, 0.02);
+  for (int c = 0; c < 2; ++c) {
+    std::vector<V3> x = bent(s, 0.5 * c);
+    for (V3& v : x) v += V3(u(rng), u(rng), u(rng));
+    check_fd(sh, x, rng);
+  }
+  // Checkpoint round trip is exact; reset restores the stress-free flat state.
+  const std::vector<double> state = sh.plastic_state();
+  Shell other(s.points, s.weights, flat, dent_material(1.5e3), 3);
+  other.set_plastic_state(state);
+  CHECK(energy_of(other, flat) == e_flat);
+  CHECK_THROWS(other.set_plastic_state(std::vector<double>(3, 1.0)));
+  other.reset_plastic_state();
+  CHECK(energy_of(other, flat) < 1e-20);
+}
+
+TEST_CASE("denting projection does not depend on the thread count", "[denting]") {
+  std::mt19937 rng(4);
+  const BezierShell s = make_bezier_grid(8, 3, 7);  // 896 quadrature points
+  const std::vector<V3> flat = bent(s, 0.0);
+  Shell a(s.points, s.weights, flat, dent_material(1.5e3), 3);
+  Shell b(s.points, s.weights, flat, dent_material(1.5e3), 3);
+  Shell c(s.points, s.weights, flat, dent_material(1.5e3), 3);
+  std::uniform_real_distribution<double> u(-0.003, 0.003);
+  std::vector<V3> x = bent(s, 1.2);
+  for (V3& v : x) v += V3(u(rng), u(rng), u(rng));
+  const double wa = a.project_plasticity(x.data(), true);
+  const double wb = b.project_plasticity(x.data(), false);
+  double wc;
+  {
+    shellmpm::ThreadLimit one(1);
+    wc = c.project_plasticity(x.data(), false);
+  }
+  CHECK(wa > 0);
+  CHECK(wa == wb);
+  CHECK(wa == wc);
+  CHECK(a.plastic_state() == b.plastic_state());
+  CHECK(a.plastic_state() == c.plastic_state());
+}
