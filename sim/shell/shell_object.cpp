@@ -159,8 +159,11 @@ double ShellObject::stable_dt(double cfl) const {
   const double c = std::sqrt(E / (rho * (1 - nu * nu)));  // membrane wave speed
   const double kappa = c * mat_.thickness / std::sqrt(12.0);  // bending: omega = kappa k^2
   const double h = min_edge_;
-  double dt = cfl * h / c;
-  dt = std::min(dt, cfl * h * h / (4.0 * kappa));
+  // Loop-basis shells with lumped masses are stable up to about 0.3 h / c (measured on
+  // a cantilever; 0.5 h / c diverges), so the shot's CFL is capped at 0.5 and scaled.
+  const double k = 0.6 * std::min(cfl, 0.5);
+  double dt = k * h / c;
+  dt = std::min(dt, k * h * h / (4.0 * kappa));
   if (mat_.stiffness_damping > 0) {
     // Central difference with damping ratio xi = beta omega / 2 at the highest frequency
     // omega = 2 / dt is stable for dt <= (2 / omega)(sqrt(1 + xi^2) - xi).
