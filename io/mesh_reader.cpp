@@ -71,12 +71,13 @@ struct Collector {
 
 }  // namespace
 
-TriMesh read_mesh(const std::string& path, const std::string& where) {
+namespace detail {
+
+const aiScene* import_triangles(Assimp::Importer& importer, const std::string& path,
+                                const std::string& where) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    throw detail::user_error_at(where, "mesh file '" + path + "' does not exist or is not a file");
-
-  Assimp::Importer importer;
+    throw user_error_at(where, "mesh file '" + path + "' does not exist or is not a file");
   // Keep only what we use: no normals, no materials, no cameras or lights.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -88,8 +89,16 @@ TriMesh read_mesh(const std::string& path, const std::string& where) {
     // aiProcess_SortByPType drops point and line meshes; say so plainly.
     if (why.find("No meshes remaining") != std::string::npos)
       why = "it has no triangles (only points or lines)";
-    throw detail::user_error_at(where, "cannot read mesh '" + path + "': " + why);
+    throw user_error_at(where, "cannot read mesh '" + path + "': " + why);
   }
+  return scene;
+}
+
+}  // namespace detail
+
+TriMesh read_mesh(const std::string& path, const std::string& where) {
+  Assimp::Importer importer;
+  const aiScene* scene = detail::import_triangles(importer, path, where);
 
   Collector c{scene, {}, true, 0};
   c.visit(scene->mRootNode, aiMatrix4x4());

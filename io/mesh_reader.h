@@ -8,6 +8,11 @@
 #include "io/user_error.h"
 #include "sim/core/types.h"
 
+struct aiScene;
+namespace Assimp {
+class Importer;
+}  // namespace Assimp
+
 namespace shellmpm {
 
 /// An indexed triangle mesh in world units [m].
@@ -41,6 +46,10 @@ TriMesh read_mesh(const std::string& path, const std::string& where);
 namespace detail {
 /// A UserError at `where` ("file:line: key", "file: key" or "file"; see read_mesh).
 UserError user_error_at(const std::string& where, const std::string& message);
+/// Reads `path` with `importer`: triangulated, identical vertices joined, points and lines
+/// dropped. @throws UserError naming `where` and the path when it cannot be read.
+const aiScene* import_triangles(Assimp::Importer& importer, const std::string& path,
+                                const std::string& where);
 }  // namespace detail
 
 }  // namespace shellmpm

@@ -93,22 +93,8 @@ PositionKey key_of(const Vec3d& p) {
 }  // namespace
 
 ShellMesh read_shell_mesh(const std::string& path, const std::string& where) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw detail::user_error_at(where, "mesh file '" + path + "' does not exist or is not a file");
-
   Assimp::Importer importer;
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                         aiProcess_SortByPType | aiProcess_ValidateDataStructure;
-  const aiScene* scene = importer.ReadFile(path, flags);
-  if (!scene || !scene->mRootNode || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
-    std::string why = importer.GetErrorString();
-    if (why.find("No meshes remaining") != std::string::npos)
-      why = "it has no triangles (only points or lines)";
-    throw detail::user_error_at(where, "cannot read mesh '" + path + "': " + why);
-  }
+  const aiScene* scene = detail::import_triangles(importer, path, where);
 
   Collector c{scene, {}, true, {}};
   c.visit(scene->mRootNode, aiMatrix4x4(), true);
