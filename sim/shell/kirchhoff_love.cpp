@@ -38,6 +38,33 @@ inline void compute_kinematics(PointKinematics<T>& k) {
   k.v2 = k.t2 - k.a3 * k.a3.dot(k.t2);
 }
 
+/// a_alpha and a_alphabeta at quadrature point q (entries [begin[q], begin[q+1]) with 5
+/// weights each), then the rest of the kinematics. The derivative weights of a point sum
+/// to zero (partition of unity), so the sums run over differences to the point's first
+/// control point: in float this keeps a_alpha and the small a_alphabeta accurate far
+/// from the origin.
+template <class T>
+void gather_kinematics(const std::vector<std::size_t>& begin, const std::vector<int>& ctrl,
+                       const std::vector<T>& coef, std::size_t q,
+                       const Eigen::Matrix<T, 3, 1>* x, PointKinematics<T>& k) {
+  k.a1.setZero();
+  k.a2.setZero();
+  k.a11.setZero();
+  k.a12.setZero();
+  k.a22.setZero();
+  const Eigen::Matrix<T, 3, 1>& x0 = x[ctrl[begin[q]]];
+  for (std::size_t e = begin[q] + 1; e < begin[q + 1]; ++e) {
+    const Eigen::Matrix<T, 3, 1> dx = x[ctrl[e]] - x0;
+    const T* c = &coef[5 * e];
+    k.a1 += c[0] * dx;
+    k.a2 += c[1] * dx;
+    k.a11 += c[2] * dx;
+    k.a12 += c[3] * dx;
+    k.a22 += c[4] * dx;
+  }
+  compute_kinematics(k);
+}
+
 /// atanh(x) / x for x in [0, 1).
 template <class T>
 inline T atanh_over_x(T x) {
@@ -272,21 +299,7 @@ void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, 
                                         double& e_membrane) const {
   using V3 = Vec3T;
   PointKinematics<T> k;
-  k.a1.setZero();
-  k.a2.setZero();
-  k.a11.setZero();
-  k.a12.setZero();
-  k.a22.setZero();
-  for (std::size_t e = begin_[q]; e < begin_[q + 1]; ++e) {
-    const V3& xj = x[ctrl_[e]];
-    const T* c = &coef_[5 * e];
-    k.a1 += c[0] * xj;
-    k.a2 += c[1] * xj;
-    k.a11 += c[2] * xj;
-    k.a12 += c[3] * xj;
-    k.a22 += c[4] * xj;
-  }
-  compute_kinematics(k);
+  gather_kinematics(begin_, ctrl_, coef_, q, x, k);
 
   const bool plastic = !fp_inv_.empty();
   const T area = area_[q];
@@ -418,21 +431,7 @@ T KirchhoffLoveShellT<T>::project_plasticity(const Vec3T* x, bool serial) {
         double w = 0.0;
         for (std::size_t q = b; q < e; ++q) {
           PointKinematics<T> k;
-          k.a1.setZero();
-          k.a2.setZero();
-          k.a11.setZero();
-          k.a12.setZero();
-          k.a22.setZero();
-          for (std::size_t en = begin_[q]; en < begin_[q + 1]; ++en) {
-            const Vec3T& xj = x[ctrl_[en]];
-            const T* c = &coef_[5 * en];
-            k.a1 += c[0] * xj;
-            k.a2 += c[1] * xj;
-            k.a11 += c[2] * xj;
-            k.a12 += c[3] * xj;
-            k.a22 += c[4] * xj;
-          }
-          compute_kinematics(k);
+          gather_kinematics(begin_, ctrl_, coef_, q, x, k);
           for (int l = 0; l < num_layers_; ++l) {
             const std::size_t ql = q * num_layers_ + l;
             const T xi3 = layer_xi3_[l];
@@ -474,21 +473,7 @@ T KirchhoffLoveShellT<T>::max_strain(const Vec3T* x, bool serial) const {
         T m = 0;
         for (std::size_t q = b; q < e; ++q) {
           PointKinematics<T> k;
-          k.a1.setZero();
-          k.a2.setZero();
-          k.a11.setZero();
-          k.a12.setZero();
-          k.a22.setZero();
-          for (std::size_t en = begin_[q]; en < begin_[q + 1]; ++en) {
-            const Vec3T& xj = x[ctrl_[en]];
-            const T* c = &coef_[5 * en];
-            k.a1 += c[0] * xj;
-            k.a2 += c[1] * xj;
-            k.a11 += c[2] * xj;
-            k.a12 += c[3] * xj;
-            k.a22 += c[4] * xj;
-          }
-          compute_kinematics(k);
+          gather_kinematics(begin_, ctrl_, coef_, q, x, k);
           for (int l = 0; l < num_layers_; ++l) {
             const std::size_t ql = q * num_layers_ + l;
             const T xi3 = layer_xi3_[l];
