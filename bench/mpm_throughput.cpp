@@ -9,10 +9,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "bench/bench_args.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
 
@@ -87,12 +87,8 @@ int main(int argc, char** argv) {
     else if (k == "--steps") steps = std::atoi(argv[i + 1]);
     else if (k == "--transfer") transfer = argv[i + 1];
     else if (k == "--dx") dx = std::atof(argv[i + 1]);
-    else if (k == "--threads") {
-      threads.clear();
-      std::stringstream ss(argv[i + 1]);
-      std::string t;
-      while (std::getline(ss, t, ',')) threads.push_back(std::atoi(t.c_str()));
-    } else {
+    else if (k == "--threads") threads = shellmpm_bench::parse_int_list(argv[i + 1]);
+    else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return 2;
     }

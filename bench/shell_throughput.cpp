@@ -8,10 +8,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "bench/bench_args.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
 
@@ -25,12 +25,8 @@ int main(int argc, char** argv) {
     const std::string k = argv[i];
     if (k == "--vertices") vertices = std::atof(argv[i + 1]);
     else if (k == "--steps") steps = std::atoi(argv[i + 1]);
-    else if (k == "--threads") {
-      threads.clear();
-      std::stringstream ss(argv[i + 1]);
-      std::string t;
-      while (std::getline(ss, t, ',')) threads.push_back(std::atoi(t.c_str()));
-    } else {
+    else if (k == "--threads") threads = shellmpm_bench::parse_int_list(argv[i + 1]);
+    else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return 2;
     }

@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "io/assimp_mesh.h"
 #include "io/mesh_reader.h"
 
 namespace shellmpm {
@@ -43,27 +44,11 @@ struct Collector {
   }
 
   void add(const aiMesh* am, const aiMatrix4x4& m) {
-    if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) return;
-    const int offset = static_cast<int>(mesh.vertices.size());
     const std::size_t first = mesh.triangles.size();
-    for (unsigned v = 0; v < am->mNumVertices; ++v) {
-      const aiVector3D p = m * am->mVertices[v];
-      mesh.vertices.emplace_back(p.x, p.y, p.z);
-    }
-    const bool uv = am->HasTextureCoords(0);
-    all_have_uvs = all_have_uvs && uv;
-    if (all_have_uvs)
-      for (unsigned v = 0; v < am->mNumVertices; ++v)
-        mesh.uvs.emplace_back(am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y);
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines
-      mesh.triangles.emplace_back(offset + static_cast<int>(face.mIndices[0]),
-                                  offset + static_cast<int>(face.mIndices[1]),
-                                  offset + static_cast<int>(face.mIndices[2]));
-    }
-    name_range(am->mName, first);
+    if (detail::append_triangles(am, m, mesh.vertices, mesh.uvs, mesh.triangles, all_have_uvs))
+      name_range(am->mName, first);
   }
+
 };
 
 struct PositionKey {

@@ -102,13 +102,13 @@ KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector
   if (mat_.stiffness_damping > 0) {
     // Rayleigh stiffness damping -beta K v, with K v from the directional derivative of
     // the elastic force: f(x + eps v) - f(x) = -eps K v + O(eps^2).
+    // f holds only the elastic force f(x) at this point.
     const Real eps = Real(1e-4);
-    std::vector<Vec3> xs(n), f2(n, Vec3::Zero()), f1(n, Vec3::Zero());
+    std::vector<Vec3> xs(n), f2(n, Vec3::Zero());
     for (std::size_t i = 0; i < n; ++i) xs[i] = x[i] + eps * v[i];
-    kl_->energy(x.data(), f1.data(), serial);
     kl_->energy(xs.data(), f2.data(), serial);
     const Real c = static_cast<Real>(mat_.stiffness_damping) / eps;
-    for (std::size_t i = 0; i < n; ++i) f[i] += c * (f2[i] - f1[i]);
+    for (std::size_t i = 0; i < n; ++i) f[i] += c * (f2[i] - f[i]);
   }
   const Vec3 g = gravity.cast<Real>();
   for (std::size_t i = 0; i < n; ++i) f[i] += mass[i] * g;
