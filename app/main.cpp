@@ -37,11 +37,33 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--frames", run.frames, "frame range A-B (or one frame A)");
   run_cmd->add_option("--output,-o", run.output, "output directory (replaces output.directory)");
   run_cmd->add_flag("--resume", run.resume, "continue from the newest checkpoint in the output directory");
+  run_cmd->add_flag("--preview", run.preview,
+                    "render each frame to preview.####.png as it is written (see `render`)");
 
   CommonArgs check;
   CLI::App* check_cmd = app.add_subcommand(
       "check", "validate a scene; print its stages, particle and grid counts, memory and time estimates");
   add_common(check_cmd, check);
+
+  RenderArgs render;
+  CLI::App* render_cmd = app.add_subcommand(
+      "render", "render a run's caches to preview.####.png, a contact sheet and an MP4");
+  render_cmd->add_option("OUTDIR", render.outdir, "output directory of a `shellmpm run`")->required();
+  render_cmd->add_option("--frames", render.frames, "frame range A-B (or one frame A); default: the run's");
+  render_cmd->add_option("--camera", render.camera, "camera name from render.cameras, or auto");
+  render_cmd->add_option("--size", render.size, "image size WxH (e.g. 1280x720)");
+  render_cmd->add_option("--renderer", render.renderer, "raster (OpenGL, OSMesa) or raytrace (Embree)")
+      ->check(CLI::IsMember({"raster", "raytrace"}));
+  render_cmd->add_option("--threads", render.threads, "threads for TBB, Embree and llvmpipe (0 = all cores)")
+      ->check(CLI::NonNegativeNumber);
+  render_cmd->add_option("--scene", render.scene, "scene file to use instead of OUTDIR/run.json");
+  render_cmd->add_option("--set", render.overrides, "override a scene key: key.path=value (repeatable)")
+      ->take_all()
+      ->allow_extra_args(false);
+  render_cmd->add_flag_callback("--quiet,-q", [&render] { render.verbosity = Verbosity::Quiet; },
+                                "errors only");
+  render_cmd->add_flag_callback("--verbose,-v", [&render] { render.verbosity = Verbosity::Verbose; },
+                                "per-frame timings");
 
   try {
     app.parse(argc, argv);
@@ -52,6 +74,7 @@ int main(int argc, char** argv) {
   try {
     if (*run_cmd) return run_command(run);
     if (*check_cmd) return check_command(check);
+    if (*render_cmd) return render_command(render);
   } catch (const UserError& e) {
     std::fprintf(stderr, "\nerror: %s\n", e.what());
     return kExitUserError;

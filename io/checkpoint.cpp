@@ -12,7 +12,7 @@
 namespace shellmpm {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '1'};
+constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '2'};
 
 template <class T>
 void put(std::ofstream& f, const T& v) {
@@ -84,12 +84,17 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
     f.write(c.stats_json.data(), static_cast<std::streamsize>(c.stats_json.size()));
     put<std::uint64_t>(f, c.shells.size());
     put(f, c.shell_plastic_work);
+    put(f, c.friction_work);
     for (const auto& sh : c.shells) {
       put<std::uint64_t>(f, sh.x.size());
       put_vec(f, sh.x);
       put_vec(f, sh.v);
       put<std::uint64_t>(f, sh.plastic.size());
       put_vec(f, sh.plastic);
+      put<std::uint64_t>(f, sh.C.size());
+      put_vec(f, sh.C);
+      put<std::uint64_t>(f, sh.a3e.size());
+      put_vec(f, sh.a3e);
     }
     f.write(kMagic, 8);
     if (!f) throw std::system_error(errno, std::generic_category(), "writing " + tmp);
@@ -131,6 +136,7 @@ Checkpoint read_checkpoint(const std::string& path) {
   const auto nshells = r.get<std::uint64_t>();
   if (nshells > 1000000) r.fail("bad shell count");
   c.shell_plastic_work = r.get<double>();
+  c.friction_work = r.get<double>();
   c.shells.resize(nshells);
   for (auto& sh : c.shells) {
     const auto np = r.get<std::uint64_t>();
@@ -138,6 +144,10 @@ Checkpoint read_checkpoint(const std::string& path) {
     r.get_vec(sh.v, np);
     const auto npl = r.get<std::uint64_t>();
     r.get_vec(sh.plastic, npl);
+    const auto nC = r.get<std::uint64_t>();
+    r.get_vec(sh.C, nC);
+    const auto na = r.get<std::uint64_t>();
+    r.get_vec(sh.a3e, na);
   }
   r.f.read(magic, 8);
   if (!r.f || std::string(magic, 8) != std::string(kMagic, 8)) r.fail("missing end marker");
@@ -151,9 +161,14 @@ void save_shells(const Solver& solver, Checkpoint& c) {
     st.x = sh->x;
     st.v = sh->v;
     st.plastic = sh->kl().plastic_state();
+    if (const ShellContact* ct = solver.contact(c.shells.size())) {
+      st.C = ct->C;
+      st.a3e = ct->a3e;
+    }
     c.shells.push_back(std::move(st));
   }
   c.shell_plastic_work = solver.shell_plastic_work();
+  c.friction_work = solver.friction_work();
 }
 
 void restore_shells(Solver& solver, const Checkpoint& c) {
@@ -166,8 +181,15 @@ void restore_shells(Solver& solver, const Checkpoint& c) {
     shells[i]->x = c.shells[i].x;
     shells[i]->v = c.shells[i].v;
     shells[i]->kl().set_plastic_state(c.shells[i].plastic);
+    if (ShellContact* ct = solver.contact(i)) {
+      if (c.shells[i].C.size() != ct->C.size() || c.shells[i].a3e.size() != ct->a3e.size())
+        throw UserError("checkpoint", 0, "", "shell '" + shells[i]->name() + "' has other contact data");
+      ct->C = c.shells[i].C;
+      ct->a3e = c.shells[i].a3e;
+    }
   }
   solver.set_shell_plastic_work(c.shell_plastic_work);
+  solver.set_friction_work(c.friction_work);
 }
 
 std::string latest_checkpoint(const std::string& dir, int max_frame) {

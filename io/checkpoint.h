@@ -18,9 +18,12 @@ struct Checkpoint {
   struct ShellState {
     std::vector<Vec3> x, v;
     std::vector<Real> plastic;
+    std::vector<Mat3> C;    ///< APIC matrices of the control points (contact on; else empty)
+    std::vector<Vec3> a3e;  ///< contact particles' normal columns (contact on; else empty)
   };
   std::vector<ShellState> shells;
   double shell_plastic_work = 0;
+  double friction_work = 0;
 };
 
 class Solver;

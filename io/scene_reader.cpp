@@ -117,6 +117,7 @@ std::vector<KeySpec> build_schema() {
     schema.insert(schema.end(), specs.begin(), specs.end());
   };
   const std::string kPinSelector = "give exactly one of indices, box, group";
+  const std::string kColorRule = "linear RGB, each in [0, 1]";
   add({
       // top level
       Spec("version", T::Int).required().ge(1).le(1),
@@ -128,6 +129,7 @@ std::vector<KeySpec> build_schema() {
       Spec("shells", T::List).def("[]"),
       Spec("preroll", T::Map).def("{}"),
       Spec("output", T::Map).def("{}"),
+      Spec("render", T::Map).def("{}"),
       // shot
       Spec("shot.frames", T::FrameRange).def("[1, 48]").ge(1),
       Spec("shot.fps", T::Number).def("24").unit("1/s").gt(0),
@@ -166,6 +168,9 @@ std::vector<KeySpec> build_schema() {
           .only_for({"snow"}),
       Spec("materials[].critical_stretch", T::Number).def("0.0075").gt(0).only_for({"snow"}),
       Spec("materials[].hardening", T::Number).def("10").ge(0).only_for({"snow"}),
+      Spec("materials[].color", T::Vec3)
+          .optional("by type: elastic green, sand tan, snow white")
+          .rule(kColorRule),
       // sources
       Spec("sources[].name", T::String)
           .optional("`source<i>` (i = list index)")
@@ -203,6 +208,22 @@ std::vector<KeySpec> build_schema() {
       Spec("shell_materials[].stiffness_damping", T::Number).def("0").unit("s").ge(0),
       Spec("shell_materials[].quadrature_inplane", T::Int).def("3").rule("one of: 1, 3, 6, 7"),
       Spec("shell_materials[].quadrature_thickness", T::Int).def("3").ge(1).le(5),
+      Spec("shell_materials[].friction", T::Number).def("0.3").ge(0),
+      Spec("shell_materials[].contact_stiffness", T::Number)
+          .optional("`youngs_modulus`")
+          .unit("Pa")
+          .gt(0),
+      Spec("shell_materials[].contact_shear", T::Number)
+          .optional("`contact_stiffness`")
+          .unit("Pa")
+          .gt(0),
+      Spec("shell_materials[].contact_samples", T::Int).def("1").rule("one of: 1, 3, 6, 7"),
+      Spec("shell_materials[].front_color", T::Vec3)
+          .optional("`render.shell_front`")
+          .rule(kColorRule),
+      Spec("shell_materials[].back_color", T::Vec3)
+          .optional("`render.shell_back`")
+          .rule(kColorRule),
       // shells
       Spec("shells[].name", T::String)
           .optional("`shell<i>` (i = list index)")
@@ -240,6 +261,7 @@ std::vector<KeySpec> build_schema() {
   add({
       Spec("shells[].output_refine", T::Int).def("0").ge(0).le(4),
       Spec("shells[].write_mesh", T::Bool).def("true"),
+      Spec("shells[].contact", T::Enum).def("auto").choices({"auto", "on", "off"}),
       // shell geometry (the value of shells[].geometry)
       Spec("shells[].geometry.type", T::Enum)
           .required()
@@ -271,6 +293,7 @@ std::vector<KeySpec> build_schema() {
           .rule("readable file; relative to the scene file"),
       // pre-roll
       Spec("preroll.enabled", T::Bool).def("false"),
+      Spec("preroll.method", T::Enum).def("static").choices({"static", "dynamic"}),
       Spec("preroll.tolerance", T::Number).def("1e-4").gt(0),
       Spec("preroll.max_steps", T::Int).def("200000").ge(1),
       // output
@@ -292,6 +315,51 @@ std::vector<KeySpec> build_schema() {
           .def("\"{name}.####.ply\"")
           .rule("exactly one run of `#`; contains `{name}` when there are several shells"),
       Spec("output.shell_format", T::Enum).def("ply").choices({"ply", "obj", "glb"}),
+      // render (previews; nothing here changes the simulation)
+      Spec("render.preview", T::Bool).def("false"),
+      Spec("render.renderer", T::Enum).def("raster").choices({"raster", "raytrace"}),
+      Spec("render.size", T::Int2).def("[960, 540]").ge(16).le(8192),
+      Spec("render.camera", T::String)
+          .optional("the first of `cameras`, else `auto`")
+          .nonempty()
+          .rule("`auto` or a name in cameras"),
+      Spec("render.cameras", T::List).def("[]"),
+      Spec("render.cameras[].name", T::String)
+          .required()
+          .nonempty()
+          .rule("unique; not `auto`"),
+      Spec("render.cameras[].position", T::Vec3).required().unit("m"),
+      Spec("render.cameras[].target", T::Vec3).required().unit("m").rule("not at position"),
+      Spec("render.cameras[].up", T::Vec3)
+          .def("[0, 1, 0]")
+          .unit_vector()
+          .rule("not along the view direction"),
+      Spec("render.cameras[].fov", T::Number).def("40").unit("deg").gt(0).lt(180),
+      Spec("render.samples", T::Int).def("4").ge(1).le(256),
+      Spec("render.ao_samples", T::Int).def("2").ge(0).le(64),
+      Spec("render.bulk", T::Enum)
+          .def("auto")
+          .choices({"auto", "volume", "surface", "particles", "none"}),
+      Spec("render.volume_extinction", T::Number).def("250").unit("1/m").gt(0),
+      Spec("render.iso_value", T::Number).def("0.5").gt(0),
+      Spec("render.particle_radius", T::Number)
+          .optional("half the particle spacing of the first source")
+          .unit("m")
+          .gt(0),
+      Spec("render.ground", T::Bool).def("true"),
+      Spec("render.key_light", T::Vec3)
+          .optional("above and beside the camera")
+          .unit_vector()
+          .rule("points towards the light"),
+      Spec("render.shell_front", T::Vec3).def("[0.8, 0.3, 0.2]").rule(kColorRule),
+      Spec("render.shell_back", T::Vec3).def("[0.2, 0.42, 0.8]").rule(kColorRule),
+      Spec("render.collider_color", T::Vec3).def("[0.45, 0.45, 0.48]").rule(kColorRule),
+      Spec("render.ground_color", T::Vec3).def("[0.5, 0.5, 0.48]").rule(kColorRule),
+      Spec("render.pattern", T::String)
+          .def("preview.####.png")
+          .rule("exactly one run of `#`; ends in .png"),
+      Spec("render.contact_sheet", T::Bool).def("true"),
+      Spec("render.movie", T::Bool).def("true"),
       // shapes (the value of sources[].shape and colliders[].shape)
       Spec("shape.type", T::Enum).required().choices(kShapeTypes),
       Spec("shape.min", T::Vec3).required().unit("m").only_for({"box"}),
@@ -1182,6 +1250,90 @@ std::vector<Keyframe> read_keyframes(MapReader& r, const std::string& key,
   return out;
 }
 
+/// A linear RGB colour: a vec3 with every component in [0, 1].
+Vec3d read_color(MapReader& r, const std::string& key) {
+  const Vec3d c = r.vec3(key);
+  for (int a = 0; a < 3; ++a) {
+    if (!(c[a] >= 0.0 && c[a] <= 1.0)) {
+      fail(r.origin_of(key), r.path_of(key) + "[" + std::to_string(a) + "]",
+           "a colour component must be in [0, 1] (linear RGB), got " + fmt_num(c[a]));
+    }
+  }
+  return c;
+}
+
+void read_render(const DocNode& node, RenderSettings& rs) {
+  MapReader r(node, "render", "render", false);
+  rs.preview = r.boolean("preview");
+  rs.renderer = r.choice("renderer");
+  const std::array<int, 2> size = r.int2("size");
+  rs.width = size[0];
+  rs.height = size[1];
+  const DocNode& cams = *r.block("cameras");
+  for (std::size_t i = 0; i < cams.items.size(); ++i) {
+    const std::string p = r.path_of("cameras") + "[" + std::to_string(i) + "]";
+    MapReader c(cams.items[i], "render.cameras[]", p, false);
+    RenderCamera cam;
+    cam.name = c.string("name");
+    if (cam.name == "auto") {
+      fail(c.origin_of("name"), c.path_of("name"),
+           "'auto' is the automatic camera's name; choose another name");
+    }
+    for (const RenderCamera& o : rs.cameras) {
+      if (o.name == cam.name)
+        fail(c.origin_of("name"), c.path_of("name"), "duplicate camera name '" + cam.name + "'");
+    }
+    cam.position = c.vec3("position");
+    cam.target = c.vec3("target");
+    const Vec3d view = cam.target - cam.position;
+    if (!(view.norm() > 0.0)) {
+      fail(c.origin_of("target"), c.path_of("target"), "must differ from position");
+    }
+    cam.up = c.vec3("up");
+    if (view.normalized().cross(cam.up).norm() < 1e-6) {
+      fail(c.origin_of("up"), c.path_of("up"),
+           "must not be parallel to the view direction (target - position)");
+    }
+    cam.fov_deg = c.number("fov");
+    c.finish();
+    rs.cameras.push_back(cam);
+  }
+  if (r.has("camera")) {
+    rs.camera = r.string("camera");
+    bool known = rs.camera == "auto";
+    std::vector<std::string> names{"auto"};
+    for (const RenderCamera& c : rs.cameras) {
+      known = known || c.name == rs.camera;
+      names.push_back(c.name);
+    }
+    if (!known) {
+      fail(r.origin_of("camera"), r.path_of("camera"),
+           "unknown camera '" + rs.camera + "' (cameras: " + join(names) + ")");
+    }
+  }
+  rs.samples = r.int32("samples");
+  rs.ao_samples = r.int32("ao_samples");
+  rs.bulk = r.choice("bulk");
+  rs.volume_extinction = r.number("volume_extinction");
+  rs.iso_value = r.number("iso_value");
+  rs.particle_radius = r.has("particle_radius") ? r.number("particle_radius") : 0.0;
+  rs.ground = r.boolean("ground");
+  if (r.has("key_light")) rs.key_light = r.vec3("key_light");
+  rs.shell_front = read_color(r, "shell_front");
+  rs.shell_back = read_color(r, "shell_back");
+  rs.collider_color = read_color(r, "collider_color");
+  rs.ground_color = read_color(r, "ground_color");
+  rs.pattern = r.string("pattern");
+  require_one_hash_run(rs.pattern, r.origin_of("pattern"), r.path_of("pattern"));
+  if (rs.pattern.size() < 4 || rs.pattern.compare(rs.pattern.size() - 4, 4, ".png") != 0) {
+    fail(r.origin_of("pattern"), r.path_of("pattern"),
+         "must end in .png, got '" + rs.pattern + "'");
+  }
+  rs.contact_sheet = r.boolean("contact_sheet");
+  rs.movie = r.boolean("movie");
+  r.finish();
+}
+
 void read_shot(const DocNode& node, ShotSettings& shot) {
   MapReader r(node, "shot", "shot", false);
   std::tie(shot.frame_start, shot.frame_end) = r.frames("frames");
@@ -1243,6 +1395,7 @@ MaterialDesc read_material(const DocNode& node, const std::string& path) {
     m.critical_stretch = r.number("critical_stretch");
     m.hardening = r.number("hardening");
   }
+  if (r.has("color")) m.color = read_color(r, "color");
   r.finish();
   return m;
 }
@@ -1306,6 +1459,18 @@ ShellMaterialDesc read_shell_material(const DocNode& node, const std::string& pa
              std::to_string(m.quadrature_inplane));
   }
   m.quadrature_thickness = r.int32("quadrature_thickness");
+  m.friction = r.number("friction");
+  m.contact_stiffness = r.has("contact_stiffness") ? r.number("contact_stiffness") : 0.0;
+  m.contact_shear = r.has("contact_shear") ? r.number("contact_shear") : 0.0;
+  m.contact_samples = r.int32("contact_samples");
+  if (m.contact_samples != 1 && m.contact_samples != 3 && m.contact_samples != 6 &&
+      m.contact_samples != 7) {
+    fail(r.origin_of("contact_samples"), r.path_of("contact_samples"),
+         "must be one of 1, 3, 6, 7 (contact particles per triangle), got " +
+             std::to_string(m.contact_samples));
+  }
+  if (r.has("front_color")) m.front_color = read_color(r, "front_color");
+  if (r.has("back_color")) m.back_color = read_color(r, "back_color");
   r.finish();
   return m;
 }
@@ -1497,6 +1662,12 @@ ShellDesc read_shell(const DocNode& node, std::size_t i, const Scene& scene,
   }
   sh.output_refine = r.int32("output_refine");
   sh.write_mesh = r.boolean("write_mesh");
+  {
+    const std::string c = r.choice("contact");
+    sh.contact = c == "on" ? ShellDesc::Contact::On
+                 : c == "off" ? ShellDesc::Contact::Off
+                              : ShellDesc::Contact::Auto;
+  }
   r.finish();
   return sh;
 }
@@ -1619,6 +1790,8 @@ Scene build_scene(const DocNode& root, const std::string& path) {
   {
     MapReader r(*top.block("preroll"), "preroll", "preroll", false);
     scene.preroll.enabled = r.boolean("enabled");
+    scene.preroll.method = r.choice("method") == "dynamic" ? PrerollSettings::Method::Dynamic
+                                                          : PrerollSettings::Method::Static;
     scene.preroll.tolerance = r.number("tolerance");
     scene.preroll.max_steps = r.int32("max_steps");
     r.finish();
@@ -1652,6 +1825,7 @@ Scene build_scene(const DocNode& root, const std::string& path) {
     o.shell_format = r.choice("shell_format");
     r.finish();
   }
+  read_render(*top.block("render"), scene.render);
   top.finish();
   return scene;
 }

@@ -25,6 +25,14 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     j["shell_bending_energy"] = s.shell_bending_energy;
     j["shell_plastic_work"] = s.shell_plastic_work;
     j["shell_max_strain"] = s.shell_max_strain;
+    j["shell_momentum"] = {s.shell_momentum.x(), s.shell_momentum.y(), s.shell_momentum.z()};
+  }
+  if (s.contact_particles > 0) {
+    j["contact_particles"] = s.contact_particles;
+    j["contact_compressed"] = s.contact_compressed;
+    j["contact_sliding"] = s.contact_sliding;
+    j["contact_energy"] = s.contact_energy;
+    j["friction_work"] = s.friction_work;
   }
   nlohmann::json wall = nlohmann::json::object();
   for (const auto& [name, sec] : s.stage_seconds) wall[name] = sec;

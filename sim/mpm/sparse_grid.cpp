@@ -15,8 +15,10 @@ void SparseGrid::setup(double dx, const Vec3d& origin) {
   origin_ = origin;
 }
 
-void SparseGrid::bin(const std::vector<Vec3>& x, bool serial) {
-  const std::size_t n = x.size();
+void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs, bool serial) {
+  const std::size_t n0 = first ? first->size() : 0;
+  const std::size_t n = n0 + xs.size();
+  auto pos = [&](std::size_t p) -> const Vec3& { return p < n0 ? (*first)[p] : xs[p - n0]; };
   pblock_of_.resize(n);
   phash_.clear();
   pblock_key.clear();
@@ -24,13 +26,13 @@ void SparseGrid::bin(const std::vector<Vec3>& x, bool serial) {
   std::uint64_t last_key = BlockHash::kEmpty;
   int last_id = -1;
   for (std::size_t p = 0; p < n; ++p) {
-    const Vec3 g = grid_coord(x[p]);
+    const Vec3 g = grid_coord(pos(p));
     const int bx = static_cast<int>(std::floor(g[0] - Real(0.5))) >> 2;
     const int by = static_cast<int>(std::floor(g[1] - Real(0.5))) >> 2;
     const int bz = static_cast<int>(std::floor(g[2] - Real(0.5))) >> 2;
     SHELLMPM_CHECK(bx >= 0 && by >= 0 && bz >= 0 && bx < (1 << 19) && by < (1 << 19) &&
                        bz < (1 << 19),
-                   << "particle " << p << " at " << x[p].transpose() << " is off the grid");
+                   << "particle " << p << " at " << pos(p).transpose() << " is off the grid");
     const std::uint64_t key = pack_block(bx, by, bz);
     if (key != last_key) {
       last_id = phash_.insert(key);
@@ -82,7 +84,7 @@ void SparseGrid::bin(const std::vector<Vec3>& x, bool serial) {
       serial);
 }
 
-void SparseGrid::gather_buffers_to_grid(bool serial) {
+void SparseGrid::gather(bool with_mass, bool serial) {
   parallel_for(
       gblock_key.size(), 4,
       [&](std::size_t gb, std::size_t ge) {
@@ -99,7 +101,7 @@ void SparseGrid::gather_buffers_to_grid(bool serial) {
                 for (int k = 0; k < iz1; ++k) {
                   const GridNode& s = buf[pad_node(i + ox, j + oy, k + oz)];
                   GridNode& d = nodes[block_node(i, j, k)];
-                  d.m += s.m;
+                  if (with_mass) d.m += s.m;
                   d.v[0] += s.v[0];
                   d.v[1] += s.v[1];
                   d.v[2] += s.v[2];

@@ -38,7 +38,10 @@ class SparseGrid {
 
   /// Bins particle positions into particle blocks, sorts an index list by block and
   /// allocates (and zeroes) the grid blocks they touch.
-  void bin(const std::vector<Vec3>& x, bool serial = false);
+  void bin(const std::vector<Vec3>& x, bool serial = false) { bin(nullptr, x, serial); }
+  /// Bins the concatenation of `first` (may be null) and `x`: index i < first->size()
+  /// is first[i], the others x[i - first->size()].
+  void bin(const std::vector<Vec3>* first, const std::vector<Vec3>& x, bool serial = false);
 
   double dx() const { return dx_; }
   const Vec3d& origin() const { return origin_; }
@@ -82,11 +85,15 @@ class SparseGrid {
   }
 
   /// Sums every particle block's buffer into the grid blocks (fixed order).
-  void gather_buffers_to_grid(bool serial = false);
+  void gather_buffers_to_grid(bool serial = false) { gather(true, serial); }
+  /// Adds every particle block buffer's v into the grid nodes' v (fixed order); the
+  /// buffers' m are ignored (velocity increments computed per block).
+  void gather_buffer_increments(bool serial = false) { gather(false, serial); }
   /// Copies grid node values into each particle block's padded buffer.
   void scatter_grid_to_buffers(bool serial = false);
 
  private:
+  void gather(bool with_mass, bool serial);
   double dx_ = 1.0, inv_dx_ = 1.0;
   Vec3d origin_{0, 0, 0};
   BlockHash phash_, ghash_;

@@ -11,17 +11,27 @@ namespace {
 
 // Kirchhoff stresses of one particle block, in block order, computed in SIMD batches
 // over runs of particles that share a material.
+// First position in block b's slice of grid.order that holds a bulk particle (indices
+// ascend within a block, other points come first).
+std::uint32_t bulk_begin(const SparseGrid& grid, const TransferParams& tp, std::size_t b) {
+  const std::uint32_t s0 = grid.pblock_start[b], s1 = grid.pblock_start[b + 1];
+  if (tp.first_bulk == 0) return s0;
+  const auto* o = grid.order.data();
+  return static_cast<std::uint32_t>(std::lower_bound(o + s0, o + s1, tp.first_bulk) - o);
+}
+
 void block_stresses(const ParticleSet& p, const SparseGrid& grid, const TransferParams& tp,
                     std::size_t b, std::vector<Mat3>& F, std::vector<Real>& pl,
                     std::vector<Mat3>& tau) {
-  const std::uint32_t s0 = grid.pblock_start[b], s1 = grid.pblock_start[b + 1];
+  const std::uint32_t s0 = bulk_begin(grid, tp, b), s1 = grid.pblock_start[b + 1];
   const std::size_t n = s1 - s0;
+  const std::uint32_t off = tp.first_bulk;
   F.resize(n);
   pl.resize(n);
   tau.resize(n);
   const bool plastic = p.has_plastic();
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t q = grid.order[s0 + i];
+    const std::uint32_t q = grid.order[s0 + i] - off;
     F[i] = p.F[q];
     pl[i] = plastic ? p.plastic[q] : Real(0);
   }
@@ -31,9 +41,9 @@ void block_stresses(const ParticleSet& p, const SparseGrid& grid, const Transfer
   }
   std::size_t i = 0;
   while (i < n) {
-    const auto mat = p.material[grid.order[s0 + i]];
+    const auto mat = p.material[grid.order[s0 + i] - off];
     std::size_t j = i + 1;
-    while (j < n && p.material[grid.order[s0 + j]] == mat) ++j;
+    while (j < n && p.material[grid.order[s0 + j] - off] == mat) ++j;
     (*tp.models)[mat].kirchhoff_batch(F.data() + i, plastic ? pl.data() + i : nullptr,
                                       tau.data() + i, j - i);
     i = j;
@@ -56,9 +66,9 @@ void p2g_block(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp,
   const Real dx = static_cast<Real>(grid.dx());
   const Real dt = tp.dt;
   const auto& rho = *tp.densities;
-  const std::uint32_t s0 = grid.pblock_start[b];
+  const std::uint32_t s0 = bulk_begin(grid, tp, b);
   for (std::uint32_t s = s0; s < grid.pblock_start[b + 1]; ++s) {
-    const std::uint32_t q = grid.order[s];
+    const std::uint32_t q = grid.order[s] - tp.first_bulk;
     const QuadraticWeights W(grid.grid_coord(p.x[q]));
     const Real vol = p.volume[q];
     const Real m = vol * rho[p.material[q]];
@@ -106,8 +116,8 @@ void g2p_block(ParticleSet& p, SparseGrid& grid, const TransferParams& tp, std::
   const Real dx = static_cast<Real>(grid.dx());
   const Real inv_dx = Real(1) / dx;
   const Real dt = tp.dt;
-  for (std::uint32_t s = grid.pblock_start[b]; s < grid.pblock_start[b + 1]; ++s) {
-    const std::uint32_t q = grid.order[s];
+  for (std::uint32_t s = bulk_begin(grid, tp, b); s < grid.pblock_start[b + 1]; ++s) {
+    const std::uint32_t q = grid.order[s] - tp.first_bulk;
     const QuadraticWeights W(grid.grid_coord(p.x[q]));
     const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
     // Sums over nodes of w v, w v i, w v j, w v k and the gradient sums, built per axis.
@@ -176,6 +186,7 @@ void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferPar
             p2g_block<true>(p, grid, tp, b);
           else
             p2g_block<false>(p, grid, tp, b);
+          if (tp.others) tp.others(b, grid.pblock_buf[b].data());
         }
       },
       tp.serial);
@@ -192,6 +203,7 @@ void grid_to_particles(ParticleSet& p, SparseGrid& grid, const TransferParams& t
             g2p_block<true>(p, grid, tp, b);
           else
             g2p_block<false>(p, grid, tp, b);
+          if (tp.others) tp.others(b, grid.pblock_buf[b].data());
         }
       },
       tp.serial);

@@ -2,6 +2,7 @@
 // quadratic B-splines, or MLS-MPM (Hu et al. 2018) where the stress enters through
 // the affine matrix. Symplectic Euler: forces are applied in P2G as a momentum change.
 #pragma once
+#include <functional>
 #include <vector>
 
 #include "sim/core/types.h"
@@ -18,6 +19,12 @@ struct TransferParams {
   bool stress = true;                           ///< add internal forces in P2G
   const std::vector<ConstitutiveModel>* models = nullptr;  ///< per material
   const std::vector<Real>* densities = nullptr;            ///< rest density per material
+  /// Binned indices below this are other points (shell control points, contact
+  /// particles); bulk particle q is binned as first_bulk + q.
+  std::uint32_t first_bulk = 0;
+  /// Called for every particle block after its bulk particles, with the block's padded
+  /// buffer, to scatter (P2G) or gather (G2P) the other points of the block.
+  std::function<void(std::size_t block, GridNode* buf)> others;
 };
 
 /// P2G: writes grid mass and momentum including dt * internal force (grid must be binned).

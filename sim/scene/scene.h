@@ -49,6 +49,7 @@ struct MaterialDesc {
   double hardening = 10.0;               ///< xi
   double max_hardening_jp_min = 0.6;     ///< clamp of Jp from below (keeps hardening finite)
   double max_hardening_jp_max = 20.0;    ///< clamp of Jp from above
+  std::optional<Vec3d> color;            ///< preview colour (linear RGB); none: by kind
 };
 
 /// A shape used by sources and colliders.
@@ -116,6 +117,13 @@ struct ShellMaterialDesc {
   double stiffness_damping = 0.0;  ///< Rayleigh stiffness-proportional damping [s]
   int quadrature_inplane = 3;   ///< in-plane points per triangle: 1, 3, 6 or 7
   int quadrature_thickness = 3; ///< Gauss points through the thickness: 1 to 5
+  // Contact (issue 4; used when the shell's control points are on the MPM grid).
+  double friction = 0.3;           ///< Coulomb coefficient c_F between shells
+  double contact_stiffness = 0;    ///< k_c [Pa]; 0 = youngs_modulus
+  double contact_shear = 0;        ///< gamma [Pa]; 0 = contact stiffness
+  int contact_samples = 1;         ///< contact particles per triangle: 1, 3, 6 or 7
+  std::optional<Vec3d> front_color;  ///< preview colour of the +normal side; none: render's
+  std::optional<Vec3d> back_color;   ///< preview colour of the other side; none: render's
 };
 
 /// A rigid keyframed motion shared by pins (and colliders).
@@ -171,14 +179,20 @@ struct ShellDesc {
   double pressure = 0.0;    ///< surface load along the normal [Pa] (positive pushes along +normal)
   std::vector<PointLoadDesc> point_loads;
   int output_refine = 0;    ///< limit-surface refinement levels of the written mesh (0..4)
+  /// Frictional contact on the MPM grid: Auto = on when the scene has a collider, bulk
+  /// material or another shell; On also gives self-contact of a lone shell.
+  enum class Contact { Auto, On, Off } contact = Contact::Auto;
   bool write_mesh = true;
 };
 
-/// Pre-roll: settle shells to static equilibrium before frame 1 (damped dynamic relaxation).
+/// Pre-roll: settle shells to static equilibrium before frame 1.
 struct PrerollSettings {
   bool enabled = false;
+  /// Static: minimise the potential energy in double precision (ShellObject::settle);
+  /// Dynamic: damped dynamic relaxation (explicit steps with kinetic damping).
+  enum class Method { Static, Dynamic } method = Method::Static;
   double tolerance = 1e-4;  ///< stop when max |residual force| / max |gravity force| < tolerance
-  int max_steps = 200000;   ///< give up (error) after this many steps
+  int max_steps = 200000;   ///< give up (error) after this many steps (static: iterations)
 };
 
 /// What to write.
@@ -197,6 +211,40 @@ struct OutputSettings {
   std::string shell_format = "ply";  ///< ply (binary) | obj | glb
 };
 
+/// A preview camera (render.cameras[]): looks from `position` at `target`.
+struct RenderCamera {
+  std::string name;
+  Vec3d position{0, 1, 3};  ///< eye [m]
+  Vec3d target{0, 0, 0};    ///< look-at point [m]
+  Vec3d up{0, 1, 0};        ///< up hint (unit); need not be orthogonal to the view
+  double fov_deg = 40.0;    ///< vertical field of view [degrees]
+};
+
+/// Preview rendering (render/, `shellmpm render`, `run --preview`). Colours are linear RGB
+/// in [0, 1]. Nothing here changes the simulation.
+struct RenderSettings {
+  bool preview = false;                    ///< render each frame while `run` writes it
+  std::string renderer = "raster";         ///< raster (OSMesa) | raytrace (Embree)
+  int width = 960, height = 540;           ///< image size [pixels]
+  std::string camera;                      ///< name in `cameras` or "auto"; empty: first, else auto
+  std::vector<RenderCamera> cameras;
+  int samples = 4;                         ///< ray traced: samples per pixel
+  int ao_samples = 2;                      ///< ray traced: ambient-occlusion rays per sample
+  std::string bulk = "auto";               ///< auto | volume | surface | particles | none
+  double volume_extinction = 250.0;        ///< extinction of density 1 [1/m]
+  double iso_value = 0.5;                  ///< density of the bulk surface
+  double particle_radius = 0.0;            ///< [m]; 0 = half the particle spacing
+  bool ground = true;                      ///< draw a ground plane
+  std::optional<Vec3d> key_light;          ///< direction towards the key light; none: camera rig
+  Vec3d shell_front{0.80, 0.30, 0.20};     ///< default shell front (+normal side) colour
+  Vec3d shell_back{0.20, 0.42, 0.80};      ///< default shell back colour
+  Vec3d collider_color{0.45, 0.45, 0.48};
+  Vec3d ground_color{0.5, 0.5, 0.48};
+  std::string pattern = "preview.####.png";
+  bool contact_sheet = true;               ///< contact_sheet.png per run
+  bool movie = true;                       ///< preview.mp4 when ffmpeg is installed
+};
+
 /// A whole shot.
 struct Scene {
   std::string path;  ///< the scene file, for messages
@@ -208,6 +256,7 @@ struct Scene {
   std::vector<ShellDesc> shells;
   PrerollSettings preroll;
   OutputSettings output;
+  RenderSettings render;
 };
 
 }  // namespace shellmpm

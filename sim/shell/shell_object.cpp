@@ -11,6 +11,45 @@
 #include "sim/shell/shell_quadrature.h"
 
 namespace shellmpm {
+namespace {
+
+/// Basis at every in-plane quadrature point of every face, with parametric weights.
+void quadrature_points(const LoopBasis& basis, int num_faces, int inplane_points,
+                       std::vector<BasisPoint>& pts, std::vector<double>& weights) {
+  const TriangleQuadrature rule = triangle_quadrature(inplane_points);
+  pts.clear();
+  weights.clear();
+  pts.reserve(num_faces * rule.points.size());
+  for (int f = 0; f < num_faces; ++f)
+    for (std::size_t q = 0; q < rule.points.size(); ++q) {
+      BasisPoint bp;
+      basis.evaluate(f, rule.points[q].x(), rule.points[q].y(), bp);
+      pts.push_back(std::move(bp));
+      weights.push_back(rule.weights[q]);
+    }
+}
+
+/// Adds gravity (lumped masses), pressure on the control mesh and point loads at x.
+template <class T>
+void add_loads(const ShellDesc& desc, const std::vector<Eigen::Vector3i>& tris,
+               const std::vector<Real>& mass, const Vec3d& gravity,
+               const std::vector<Eigen::Matrix<T, 3, 1>>& x,
+               std::vector<Eigen::Matrix<T, 3, 1>>& f) {
+  using V3 = Eigen::Matrix<T, 3, 1>;
+  const V3 g = gravity.cast<T>();
+  for (std::size_t i = 0; i < x.size(); ++i) f[i] += static_cast<T>(mass[i]) * g;
+  if (desc.pressure != 0) {
+    // Pressure on the control mesh: p * area * normal, a third to each corner.
+    for (const auto& t : tris) {
+      const V3 an = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);  // 2 * area * n
+      const V3 fc = (static_cast<T>(desc.pressure) / T(6)) * an;
+      for (int c = 0; c < 3; ++c) f[t[c]] += fc;
+    }
+  }
+  for (const PointLoadDesc& pl : desc.point_loads) f[pl.index] += pl.force.cast<T>();
+}
+
+}  // namespace
 
 ShellMesh build_shell_rest_mesh(const ShellDesc& d) {
   ShellMesh m;
@@ -44,17 +83,9 @@ ShellObject::ShellObject(const ShellDesc& desc, const ShellMaterialDesc& mat, Sh
   const int nv = static_cast<int>(rest.size());
   basis_ = std::make_unique<LoopBasis>(nv, tris_);
   // Quadrature points: every face with the in-plane rule.
-  const TriangleQuadrature rule = triangle_quadrature(mat.quadrature_inplane);
   std::vector<BasisPoint> pts;
   std::vector<double> weights;
-  pts.reserve(tris_.size() * rule.points.size());
-  for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
-    for (std::size_t q = 0; q < rule.points.size(); ++q) {
-      BasisPoint bp;
-      basis_->evaluate(f, rule.points[q].x(), rule.points[q].y(), bp);
-      pts.push_back(std::move(bp));
-      weights.push_back(rule.weights[q]);
-    }
+  quadrature_points(*basis_, static_cast<int>(tris_.size()), mat.quadrature_inplane, pts, weights);
   kl_ = std::make_unique<KirchhoffLoveShell>(std::move(pts), std::move(weights), rest, mat,
                                              mat.quadrature_thickness);
   limit_ = std::make_unique<LimitMesh>(*basis_, tris_, rest_mesh.uvs, desc.output_refine);
@@ -110,18 +141,70 @@ KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector
     const Real c = static_cast<Real>(mat_.stiffness_damping) / eps;
     for (std::size_t i = 0; i < n; ++i) f[i] += c * (f2[i] - f[i]);
   }
-  const Vec3 g = gravity.cast<Real>();
-  for (std::size_t i = 0; i < n; ++i) f[i] += mass[i] * g;
-  if (desc_.pressure != 0) {
-    // Pressure on the control mesh: p * area * normal, a third to each corner.
-    for (const auto& t : tris_) {
-      const Vec3 an = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);  // 2 * area * n
-      const Vec3 fc = (static_cast<Real>(desc_.pressure) / Real(6)) * an;
-      for (int c = 0; c < 3; ++c) f[t[c]] += fc;
-    }
-  }
-  for (const PointLoadDesc& pl : desc_.point_loads) f[pl.index] += pl.force.cast<Real>();
+  add_loads(desc_, tris_, mass, gravity, x, f);
   return e;
+}
+
+StaticSolveResult ShellObject::settle(const Vec3d& gravity, double time, double tolerance,
+                                      int max_iterations, bool serial) {
+  const std::size_t n = x.size();
+  // A double copy of the elastic data, with the current plastic state.
+  std::vector<BasisPoint> pts;
+  std::vector<double> weights;
+  quadrature_points(*basis_, static_cast<int>(tris_.size()), mat_.quadrature_inplane, pts, weights);
+  StaticSolveOptions opt;
+  opt.tolerance = tolerance;
+  opt.max_iterations = max_iterations;
+  // Coupling: points sharing a quadrature point (the union over each face's points).
+  opt.coupling.assign(n, {});
+  const std::size_t per_face = pts.size() / std::max<std::size_t>(tris_.size(), 1);
+  std::vector<int> face_ctrl;
+  for (std::size_t f = 0; f < tris_.size(); ++f) {
+    face_ctrl.clear();
+    for (std::size_t q = f * per_face; q < (f + 1) * per_face; ++q)
+      face_ctrl.insert(face_ctrl.end(), pts[q].ctrl.begin(), pts[q].ctrl.end());
+    std::sort(face_ctrl.begin(), face_ctrl.end());
+    face_ctrl.erase(std::unique(face_ctrl.begin(), face_ctrl.end()), face_ctrl.end());
+    for (int j : face_ctrl)
+      opt.coupling[j].insert(opt.coupling[j].end(), face_ctrl.begin(), face_ctrl.end());
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    std::vector<int>& c = opt.coupling[j];
+    c.push_back(static_cast<int>(j));
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+  }
+  KirchhoffLoveShellT<double> kl(std::move(pts), std::move(weights), rest, mat_,
+                                 mat_.quadrature_thickness);
+  if (kl.has_plasticity()) {
+    const std::vector<Real>& fp = kl_->plastic_state();
+    kl.set_plastic_state(std::vector<double>(fp.begin(), fp.end()));
+  }
+  // Pinned components at the pin pose at `time` (released pins are free).
+  std::vector<Vec3d> xd(n);
+  std::vector<std::uint8_t> free_mask(n, 7);
+  for (std::size_t i = 0; i < n; ++i) {
+    xd[i] = x[i].cast<double>();
+    if (!pin_mask[i]) continue;
+    const PinDesc& pin = desc_.pins[pin_of[i]];
+    if (pin.release_time >= 0 && time >= pin.release_time) continue;
+    const Vec3d target = keyframe_pose(pin.keyframes, time).apply(rest[i]);
+    for (int a = 0; a < 3; ++a)
+      if (pin_mask[i] & (1u << a)) {
+        xd[i][a] = target[a];
+        free_mask[i] &= static_cast<std::uint8_t>(~(1u << a));
+      }
+  }
+  auto total_force = [&](const std::vector<Vec3d>& p, std::vector<Vec3d>& f) {
+    kl.energy(p.data(), f.data(), serial);
+    add_loads(desc_, tris_, mass, gravity, p, f);
+  };
+  const StaticSolveResult r = solve_static(xd, free_mask, total_force, opt);
+  for (std::size_t i = 0; i < n; ++i) {
+    x[i] = xd[i].cast<Real>();
+    v[i].setZero();
+  }
+  return r;
 }
 
 void ShellObject::integrate(const std::vector<Vec3>& f, double t, double dt, bool serial) {

@@ -12,6 +12,7 @@
 #include "sim/shell/kirchhoff_love.h"
 #include "sim/shell/limit_mesh.h"
 #include "sim/shell/loop_basis.h"
+#include "sim/shell/static_solver.h"
 
 namespace shellmpm {
 
@@ -30,6 +31,17 @@ class ShellObject {
   /// (resized); returns the elastic energy split.
   KirchhoffLoveShell::Energy forces(const Vec3d& gravity, std::vector<Vec3>& f,
                                     bool serial) const;
+  /// Static equilibrium under the elastic forces, gravity, pressure and point loads, with
+  /// pinned components held at their pin pose at `time` (pre-roll). Positions, forces
+  /// and the solve are in double (a temporary double copy of the Kirchhoff-Love data):
+  /// float positions round by ulp(|x|) (1.5e-8 m at 0.2 m from the origin), a membrane
+  /// force noise of about E t ulp(|x|) per control point (3e-4 N for E = 1e7 Pa, t = 2 mm),
+  /// which can exceed the loads (measured in tests/sim/test_cantilever.cpp).
+  /// Newton-like L-BFGS with a finite-difference stiffness (static_solver.h); stops at
+  /// max |free force component| < tolerance [N]. Writes x and zeroes v; the plastic
+  /// state is kept (no return mapping).
+  StaticSolveResult settle(const Vec3d& gravity, double time, double tolerance,
+                           int max_iterations, bool serial);
   /// One symplectic Euler step with the forces f: damping, pins at time t + dt.
   void integrate(const std::vector<Vec3>& f, double t, double dt, bool serial);
   /// Denting return mapping; returns plastic work [J]. No-op without a yield stress.
@@ -46,6 +58,11 @@ class ShellObject {
   }
   const LimitMesh& limit_mesh() const { return *limit_; }
   const ShellDesc& desc() const { return desc_; }
+  const ShellMaterialDesc& material() const { return mat_; }
+  const LoopBasis& basis() const { return *basis_; }
+  const std::vector<Eigen::Vector3i>& triangles() const { return tris_; }
+  /// Shortest rest control-mesh edge [m].
+  double min_edge() const { return min_edge_; }
   KirchhoffLoveShell& kl() { return *kl_; }
   const KirchhoffLoveShell& kl() const { return *kl_; }
 

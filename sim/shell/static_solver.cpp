@@ -1,71 +1,198 @@
 #include "sim/shell/static_solver.h"
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <memory>
+
+#include "sim/core/check.h"
 
 namespace shellmpm {
 namespace {
 
 using VecX = Eigen::VectorXd;
+using SpMat = Eigen::SparseMatrix<double>;
+using ForceFn = std::function<void(const std::vector<Vec3d>&, std::vector<Vec3d>&)>;
 
 struct Problem {
-  std::vector<Vec3>& x;
-  const std::vector<std::uint8_t>& mask;
-  const std::function<void(const std::vector<Vec3>&, std::vector<Vec3>&)>& forces;
+  std::vector<Vec3d>& x;
+  const ForceFn& forces;
   std::vector<std::pair<int, int>> dofs;  // (point, component) of each free dof
-  VecX x0;                                // free dofs at the start (double)
-  std::vector<Vec3> work, f;
+  std::vector<int> dof_of;                // 3 * point + component -> dof, or -1
+  std::vector<Vec3d> work, f;
+  int calls = 0;
 
   VecX gather() const {
     VecX v(dofs.size());
     for (std::size_t k = 0; k < dofs.size(); ++k) v[k] = x[dofs[k].first][dofs[k].second];
     return v;
   }
+  void set(const VecX& q, std::vector<Vec3d>& out) const {
+    out = x;
+    for (std::size_t k = 0; k < dofs.size(); ++k) out[dofs[k].first][dofs[k].second] = q[k];
+  }
+  // Full force vector at positions p into f.
+  void eval(const std::vector<Vec3d>& p) {
+    f.assign(x.size(), Vec3d::Zero());
+    forces(p, f);
+    ++calls;
+  }
   // Gradient of the potential (minus the force) at free dofs q.
   VecX gradient(const VecX& q) {
-    work = x;
-    for (std::size_t k = 0; k < dofs.size(); ++k)
-      work[dofs[k].first][dofs[k].second] = static_cast<Real>(q[k]);
-    f.assign(x.size(), Vec3::Zero());
-    forces(work, f);
+    set(q, work);
+    eval(work);
     VecX g(dofs.size());
-    for (std::size_t k = 0; k < dofs.size(); ++k) g[k] = -static_cast<double>(f[dofs[k].first][dofs[k].second]);
+    for (std::size_t k = 0; k < dofs.size(); ++k) g[k] = -f[dofs[k].first][dofs[k].second];
     return g;
-  }
-  void scatter(const VecX& q) {
-    for (std::size_t k = 0; k < dofs.size(); ++k)
-      x[dofs[k].first][dofs[k].second] = static_cast<Real>(q[k]);
   }
 };
 
+/// Greedy distance-2 colouring: points sharing a colour have disjoint coupling sets, so
+/// one force evaluation with all of them perturbed separates their stiffness columns.
+std::vector<std::vector<int>> colour_points(const std::vector<std::vector<int>>& coupling,
+                                            const std::vector<char>& movable) {
+  const int n = static_cast<int>(coupling.size());
+  std::vector<int> colour(n, -1), stamp;
+  std::vector<std::vector<int>> groups;
+  for (int j = 0; j < n; ++j) {
+    if (!movable[j]) continue;
+    stamp.assign(groups.size() + 1, -1);
+    for (int i : coupling[j])
+      for (int k : coupling[i])
+        if (colour[k] >= 0) stamp[colour[k]] = j;
+    int c = 0;
+    while (stamp[c] == j) ++c;
+    if (c == static_cast<int>(groups.size())) groups.emplace_back();
+    colour[j] = c;
+    groups[c].push_back(j);
+  }
+  return groups;
+}
+
+/// Tangent stiffness K = -df/dq at q (forward differences, symmetrised).
+SpMat fd_stiffness(Problem& pb, const VecX& q, const std::vector<std::vector<int>>& coupling,
+                   const std::vector<std::vector<int>>& groups, double eps) {
+  std::vector<Eigen::Triplet<double>> trip;
+  std::vector<Vec3d> base;
+  pb.set(q, base);
+  pb.eval(base);
+  const std::vector<Vec3d> f0 = pb.f;
+  std::vector<Vec3d> p;
+  for (const std::vector<int>& group : groups)
+    for (int a = 0; a < 3; ++a) {
+      p = base;
+      bool any = false;
+      for (int j : group)
+        if (pb.dof_of[3 * j + a] >= 0) {
+          p[j][a] += eps;
+          any = true;
+        }
+      if (!any) continue;
+      pb.eval(p);
+      for (int j : group) {
+        const int col = pb.dof_of[3 * j + a];
+        if (col < 0) continue;
+        for (int i : coupling[j])
+          for (int b = 0; b < 3; ++b) {
+            const int row = pb.dof_of[3 * i + b];
+            if (row >= 0) trip.emplace_back(row, col, -(pb.f[i][b] - f0[i][b]) / eps);
+          }
+      }
+    }
+  const int n = static_cast<int>(pb.dofs.size());
+  SpMat K(n, n);
+  K.setFromTriplets(trip.begin(), trip.end());
+  const SpMat Kt = K.transpose();
+  return 0.5 * (K + Kt);
+}
+
+/// Factorises K + mu diag(|K_ii| + mean |K_ii|), raising mu from 0 until the factor is
+/// positive definite (a descent direction for any gradient).
+std::unique_ptr<Eigen::SimplicialLDLT<SpMat>> factorise(const SpMat& K) {
+  const int n = static_cast<int>(K.rows());
+  VecX diag = K.diagonal().cwiseAbs();
+  const double mean = diag.sum() / std::max(n, 1);
+  SHELLMPM_CHECK(std::isfinite(mean), << "non-finite stiffness (forces not finite?)");
+  auto solver = std::make_unique<Eigen::SimplicialLDLT<SpMat>>();
+  solver->analyzePattern(K);
+  for (double mu = 0;; mu = (mu == 0) ? 1e-8 : 10 * mu) {
+    SHELLMPM_CHECK(mu < 1e8, << "stiffness could not be made positive definite");
+    SpMat A = K;
+    if (mu > 0)
+      for (int i = 0; i < n; ++i) A.coeffRef(i, i) += mu * (diag[i] + mean);
+    solver->factorize(A);
+    if (solver->info() == Eigen::Success && (solver->vectorD().array() > 0).all()) return solver;
+  }
+}
+
 }  // namespace
 
-StaticSolveResult solve_static(std::vector<Vec3>& x, const std::vector<std::uint8_t>& free_mask,
-                               const std::function<void(const std::vector<Vec3>&, std::vector<Vec3>&)>& forces,
-                               double tolerance, int max_iterations) {
-  Problem pb{x, free_mask, forces, {}, {}, {}, {}};
+StaticSolveResult solve_static(std::vector<Vec3d>& x, const std::vector<std::uint8_t>& free_mask,
+                               const ForceFn& forces, const StaticSolveOptions& opt) {
+  SHELLMPM_CHECK(free_mask.size() == x.size(), << free_mask.size() << " vs " << x.size());
+  const bool newton = !opt.coupling.empty();
+  if (newton) SHELLMPM_CHECK(opt.coupling.size() == x.size(), << opt.coupling.size());
+  Problem pb{x, forces, {}, std::vector<int>(3 * x.size(), -1), {}, {}, 0};
+  std::vector<char> movable(x.size(), 0);
   for (std::size_t i = 0; i < x.size(); ++i)
     for (int a = 0; a < 3; ++a)
-      if (free_mask[i] & (1u << a)) pb.dofs.emplace_back(static_cast<int>(i), a);
+      if (free_mask[i] & (1u << a)) {
+        pb.dof_of[3 * i + a] = static_cast<int>(pb.dofs.size());
+        pb.dofs.emplace_back(static_cast<int>(i), a);
+        movable[i] = 1;
+      }
   StaticSolveResult res;
   if (pb.dofs.empty()) {
     res.converged = true;
     return res;
   }
+  // Length scale of the problem: the bounding-box diagonal (or the largest coordinate,
+  // or 1 for a single point at the origin).
+  Eigen::AlignedBox<double, 3> box;
+  double size = 0;
+  for (const Vec3d& p : x) {
+    box.extend(p);
+    size = std::max(size, p.lpNorm<Eigen::Infinity>());
+  }
+  size = std::max(size, box.diagonal().norm());
+  if (!(size > 0)) size = 1;
+  const double max_move = opt.max_move * size;
+  std::vector<std::vector<int>> groups;
+  double eps = 0;
+  if (newton) {
+    groups = colour_points(opt.coupling, movable);
+    eps = opt.fd_step * size;
+  }
   VecX q = pb.gather();
   VecX g = pb.gradient(q);
+  std::unique_ptr<Eigen::SimplicialLDLT<SpMat>> H0;
   constexpr int kMemory = 12;
   std::deque<std::pair<VecX, VecX>> hist;  // (s, y)
-  double step_scale = 1e-3 / std::max(g.lpNorm<Eigen::Infinity>(), 1e-300);
-  for (int it = 0; it < max_iterations; ++it) {
+  const double step_scale = 1e-3 / std::max(g.lpNorm<Eigen::Infinity>(), 1e-300);
+  int since_refresh = 0;
+  std::vector<double> best;  // best residual up to each iteration
+  for (int it = 0; it < opt.max_iterations; ++it) {
     res.iterations = it;
     res.residual = g.lpNorm<Eigen::Infinity>();
-    if (res.residual < tolerance) {
+    if (res.residual < opt.tolerance) {
       res.converged = true;
       break;
     }
+    best.push_back(best.empty() ? res.residual : std::min(best.back(), res.residual));
+    if (it >= opt.stall_iterations && !(best.back() < 0.5 * best[it - opt.stall_iterations])) {
+      res.stalled = true;
+      break;
+    }
+    if (newton && (!H0 || since_refresh >= opt.hessian_every)) {
+      H0 = factorise(fd_stiffness(pb, q, opt.coupling, groups, eps));
+      ++res.hessian_evaluations;
+      hist.clear();
+      since_refresh = 0;
+    }
+    ++since_refresh;
     // Two-loop recursion: d = -H g.
     VecX d = -g;
     std::vector<double> alpha(hist.size());
@@ -74,7 +201,9 @@ StaticSolveResult solve_static(std::vector<Vec3>& x, const std::vector<std::uint
       alpha[k] = s.dot(d) / y.dot(s);
       d -= alpha[k] * y;
     }
-    if (!hist.empty()) {
+    if (H0) {
+      d = H0->solve(d);
+    } else if (!hist.empty()) {
       const auto& [s, y] = hist.back();
       d *= s.dot(y) / y.dot(y);
     } else {
@@ -86,15 +215,29 @@ StaticSolveResult solve_static(std::vector<Vec3>& x, const std::vector<std::uint
       d += (alpha[k] - beta) * s;
     }
     double dphi0 = g.dot(d);
-    if (!(dphi0 < 0)) {  // not a descent direction: restart from steepest descent
+    if (!(dphi0 < 0)) {  // not a descent direction: restart without history
       hist.clear();
-      d = -step_scale * g;
+      d = H0 ? VecX(-H0->solve(g)) : VecX(-step_scale * g);
       dphi0 = g.dot(d);
     }
-    // Secant search on phi'(a) = g(q + a d) . d for a zero, starting at a = 1.
+    // Trust cap: no point moves further than max_move in one iteration (the first steps
+    // of a sagging drape see only bending stiffness and would go far out).
+    const double dmax = d.lpNorm<Eigen::Infinity>();
+    if (dmax > max_move) {
+      d *= max_move / dmax;
+      dphi0 = g.dot(d);
+    }
+    // Secant search on phi'(a) = g(q + a d) . d for a zero, starting at a = 1; a step to
+    // where the forces are not finite (an inverted element) is halved.
     double a_lo = 0, dphi_lo = dphi0, a = 1;
     VecX g_new = pb.gradient(q + a * d);
     double dphi = g_new.dot(d);
+    for (int k = 0; k < 40 && !std::isfinite(dphi); ++k) {
+      a *= 0.5;
+      g_new = pb.gradient(q + a * d);
+      dphi = g_new.dot(d);
+    }
+    SHELLMPM_CHECK(std::isfinite(dphi), << "forces not finite near the current state");
     for (int ls = 0; ls < 12 && std::abs(dphi) > 0.3 * std::abs(dphi0); ++ls) {
       double a_next;
       if (dphi < 0) {
@@ -106,9 +249,12 @@ StaticSolveResult solve_static(std::vector<Vec3>& x, const std::vector<std::uint
         a_next = a_lo + (a - a_lo) * dphi_lo / (dphi_lo - dphi);
       }
       if (!(a_next > 0) || !std::isfinite(a_next)) break;
+      const VecX g_try = pb.gradient(q + a_next * d);
+      const double dphi_try = g_try.dot(d);
+      if (!std::isfinite(dphi_try)) break;  // keep the last finite point
       a = a_next;
-      g_new = pb.gradient(q + a * d);
-      dphi = g_new.dot(d);
+      g_new = g_try;
+      dphi = dphi_try;
     }
     const VecX s = a * d;
     const VecX y = g_new - g;
@@ -118,10 +264,14 @@ StaticSolveResult solve_static(std::vector<Vec3>& x, const std::vector<std::uint
       hist.emplace_back(s, y);
       if (static_cast<int>(hist.size()) > kMemory) hist.pop_front();
     }
+    res.iterations = it + 1;
   }
   res.residual = g.lpNorm<Eigen::Infinity>();
-  res.converged = res.converged || res.residual < tolerance;
-  pb.scatter(q);
+  res.converged = res.converged || res.residual < opt.tolerance;
+  res.force_evaluations = pb.calls;
+  std::vector<Vec3d> out;
+  pb.set(q, out);
+  x = out;
   return res;
 }
 

@@ -27,6 +27,13 @@ struct FrameStats {
   double shell_bending_energy = 0;     ///< [J]
   double shell_plastic_work = 0;       ///< dissipated by denting since the start [J]
   double shell_max_strain = 0;         ///< largest principal Hencky strain
+  Vec3d shell_momentum{0, 0, 0};       ///< sum m v over control points [kg m/s]
+  // Contact (shells on the grid).
+  std::size_t contact_particles = 0;   ///< contact particles of all shells
+  std::size_t contact_compressed = 0;  ///< in contact (s3 < 1) after the frame's last step
+  std::size_t contact_sliding = 0;     ///< sliding in the frame's last step
+  double contact_energy = 0;           ///< sum V psi [J]
+  double friction_work = 0;            ///< dissipated by sliding friction since the start [J]
   /// Wall-clock seconds per stage, in stage order (not deterministic, unlike the rest).
   std::vector<std::pair<std::string, double>> stage_seconds;
   double wall_seconds = 0;

@@ -57,6 +57,7 @@ Solver::Solver(const Scene& scene, SolverOptions opt) : scene_(scene), opt_(opt)
     shell_dt_ = std::min(shell_dt_, shells_.back()->stable_dt(s.cfl));
   }
   shell_forces_.resize(shells_.size());
+  setup_contact();
   if (opt_.fill_sources) {
     for (std::size_t i = 0; i < samplers_.size(); ++i) {
       if (scene_.sources[i].emit) continue;
@@ -78,43 +79,145 @@ void Solver::add_particles_from(std::size_t i, const std::vector<Vec3d>& pts) {
   for (const Vec3d& p : pts) particles_.push_back(p.cast<Real>(), vel, vol, mat, pl0);
 }
 
+void Solver::setup_contact() {
+  // Contact is on for a shell when asked, or (auto) when there is something to touch.
+  const bool others = !scene_.colliders.empty() || !scene_.sources.empty() || shells_.size() > 1;
+  contacts_.resize(shells_.size());
+  grid_shells_.clear();
+  for (std::size_t i = 0; i < shells_.size(); ++i) {
+    const ShellDesc::Contact mode = shells_[i]->desc().contact;
+    const bool on = mode == ShellDesc::Contact::On || (mode == ShellDesc::Contact::Auto && others);
+    if (!on) continue;
+    const ShellMaterialDesc& m = shells_[i]->material();
+    ContactParams cp;
+    cp.kc = m.contact_stiffness > 0 ? m.contact_stiffness : m.youngs_modulus;
+    cp.gamma = m.contact_shear > 0 ? m.contact_shear : cp.kc;
+    cp.friction = m.friction;
+    contacts_[i] = std::make_unique<ShellContact>(shells_[i]->basis(), shells_[i]->rest, m.thickness,
+                                                  m.contact_samples, cp);
+    // Contact wave speed: psi'' <= 2 k_c (at s3 = 0) and gamma, over the shell density.
+    const double c = std::sqrt(2.0 * std::max(cp.kc, cp.gamma) / m.density);
+    shell_dt_ = std::min(shell_dt_, scene_.shot.cfl * scene_.shot.dx / c);
+    GridShell g;
+    g.shell = shells_[i].get();
+    g.contact = contacts_[i].get();
+    grid_shells_.push_back(std::move(g));
+  }
+  shell_table_.build(grid_shells_);
+}
+
+TransferParams Solver::transfer_params() {
+  TransferParams tp;
+  tp.dt = static_cast<Real>(dt_);
+  tp.mls = scene_.shot.transfer == "mls";
+  tp.serial = opt_.serial;
+  tp.models = &models_;
+  tp.densities = &densities_;
+  tp.first_bulk = static_cast<std::uint32_t>(shell_table_.size());
+  return tp;
+}
+
 void Solver::build_stages() {
   stages_.clear();
+  const bool on_grid = !grid_shells_.empty();
+  bool direct = false;
+  for (const auto& c : contacts_) direct = direct || c == nullptr;
   if (!shells_.empty()) {
-    // Shells without contact: control points integrate directly, no grid.
     stages_.push_back({"shell_forces", [this] {
-                         for (std::size_t i = 0; i < shells_.size(); ++i)
-                           shells_[i]->forces(scene_.shot.gravity, shell_forces_[i], opt_.serial);
+                         const Vec3d zero = Vec3d::Zero();
+                         for (std::size_t i = 0; i < shells_.size(); ++i) {
+                           ShellObject& sh = *shells_[i];
+                           if (!contacts_[i]) {
+                             sh.forces(scene_.shot.gravity, shell_forces_[i], opt_.serial);
+                             continue;
+                           }
+                           // On the grid, gravity is applied to the nodes.
+                           sh.forces(zero, shell_forces_[i], opt_.serial);
+                           const Real damp = static_cast<Real>(sh.material().damping);
+                           if (damp > 0)
+                             for (std::size_t j = 0; j < sh.size(); ++j)
+                               shell_forces_[i][j] -= damp * sh.mass[j] * sh.v[j];
+                         }
                        }});
-    stages_.push_back({"shell_update", [this] {
-                         for (std::size_t i = 0; i < shells_.size(); ++i)
-                           shells_[i]->integrate(shell_forces_[i], time_, dt_, opt_.serial);
-                       }});
-    bool denting = false;
-    for (const auto& sh : shells_) denting = denting || sh->has_denting();
-    if (denting)
-      stages_.push_back({"denting", [this] {
-                           for (auto& sh : shells_) plastic_work_ += sh->project_plasticity(opt_.serial);
+    // Shells without contact: control points integrate directly, no grid.
+    if (direct)
+      stages_.push_back({"shell_update", [this] {
+                           for (std::size_t i = 0; i < shells_.size(); ++i)
+                             if (!contacts_[i])
+                               shells_[i]->integrate(shell_forces_[i], time_, dt_, opt_.serial);
                          }});
   }
-  const bool bulk = !scene_.sources.empty();
-  if (!bulk) return;
-  stages_.push_back({"bin", [this] { grid_.bin(particles_.x, opt_.serial); }});
+  if (on_grid)
+    stages_.push_back({"contact", [this] {
+                         std::size_t k = 0;
+                         for (std::size_t i = 0; i < shells_.size(); ++i) {
+                           if (!contacts_[i]) continue;
+                           GridShell& g = grid_shells_[k++];
+                           prescribe_pins(*g.shell, time_, dt_, g.held);
+                           g.contact->update_positions(g.shell->x.data(), opt_.serial);
+                           g.force.swap(shell_forces_[i]);
+                           g.contact->forces(g.shell->x.data(), g.force.data(), opt_.serial);
+                         }
+                         clamp_to_domain();
+                       }});
+  if (on_grid || !scene_.sources.empty()) add_grid_stages();
+  bool denting = false;
+  for (const auto& sh : shells_) denting = denting || sh->has_denting();
+  if (denting)
+    stages_.push_back({"denting", [this] {
+                         for (auto& sh : shells_) plastic_work_ += sh->project_plasticity(opt_.serial);
+                       }});
+  if (any_emit_) stages_.push_back({"emit", [this] { emit(); }});
+}
+
+void Solver::add_grid_stages() {
+  const bool on_grid = !grid_shells_.empty();
+  stages_.push_back({"bin", [this] {
+                       const bool shells = !grid_shells_.empty();
+                       if (shells) shell_table_.positions(grid_shells_, shell_points_);
+                       grid_.bin(shells ? &shell_points_ : nullptr, particles_.x, opt_.serial);
+                     }});
   stages_.push_back({"p2g", [this] {
-                       TransferParams tp{static_cast<Real>(dt_), scene_.shot.transfer == "mls",
-                                         opt_.serial, true, &models_, &densities_};
+                       TransferParams tp = transfer_params();
+                       const Real dt = tp.dt;
+                       if (!grid_shells_.empty())
+                         tp.others = [this, dt](std::size_t b, GridNode* buf) {
+                           shell_p2g_block(grid_, shell_table_, grid_shells_, dt, b, buf);
+                         };
                        particles_to_grid(particles_, grid_, tp);
                      }});
   stages_.push_back({"grid", [this] { grid_update(); }});
+  if (on_grid)
+    stages_.push_back({"contact_grid", [this] {
+                         contact_normal_forces(grid_, shell_table_, grid_shells_,
+                                               static_cast<Real>(dt_), opt_.serial);
+                         apply_walls();
+                       }});
   if (!colliders_.empty()) stages_.push_back({"colliders", [this] { apply_colliders(); }});
   stages_.push_back({"g2p", [this] {
-                       TransferParams tp{static_cast<Real>(dt_), scene_.shot.transfer == "mls",
-                                         opt_.serial, true, &models_, &densities_};
+                       TransferParams tp = transfer_params();
+                       const Real dt = tp.dt;
+                       if (!grid_shells_.empty())
+                         tp.others = [this, dt](std::size_t b, GridNode* buf) {
+                           shell_g2p_block(grid_, shell_table_, grid_shells_, dt, b, buf);
+                         };
                        grid_to_particles(particles_, grid_, tp);
                        clamp_to_domain();
                      }});
+  if (on_grid)
+    stages_.push_back({"friction", [this] {
+                         ContactStepStats total;
+                         for (GridShell& g : grid_shells_) {
+                           const ContactStepStats st = g.contact->return_map(g.shell->x.data(), opt_.serial);
+                           total.compressed += st.compressed;
+                           total.sliding += st.sliding;
+                           total.friction_work += st.friction_work;
+                           total.separation_work += st.separation_work;
+                         }
+                         friction_work_ += total.friction_work;
+                         contact_step_ = total;
+                       }});
   if (any_plastic_) stages_.push_back({"plasticity", [this] { project_plasticity(); }});
-  if (any_emit_) stages_.push_back({"emit", [this] { emit(); }});
 }
 
 std::vector<std::string> Solver::stage_names() const {
@@ -126,6 +229,7 @@ std::vector<std::string> Solver::stage_names() const {
 void Solver::grid_update() {
   const Vec3 g = scene_.shot.gravity.cast<Real>();
   const Real dt = static_cast<Real>(dt_);
+  const bool walls = grid_shells_.empty();  // with contact, walls come after contact forces
   parallel_for(
       grid_.num_grid_blocks(), 16,
       [&](std::size_t bb, std::size_t be) {
@@ -134,9 +238,24 @@ void Solver::grid_update() {
             const Real inv_m = Real(1) / nd.m;
             for (int a = 0; a < 3; ++a) {
               Real v = nd.v[a] * inv_m + dt * g[a];
-              if (n[a] < kWallCells && v < 0) v = 0;
-              if (n[a] > domain_cells_[a] - kWallCells && v > 0) v = 0;
+              if (walls && n[a] < kWallCells && v < 0) v = 0;
+              if (walls && n[a] > domain_cells_[a] - kWallCells && v > 0) v = 0;
               nd.v[a] = v;
+            }
+          });
+      },
+      opt_.serial);
+}
+
+void Solver::apply_walls() {
+  parallel_for(
+      grid_.num_grid_blocks(), 16,
+      [&](std::size_t bb, std::size_t be) {
+        for (std::size_t b = bb; b < be; ++b)
+          grid_.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
+            for (int a = 0; a < 3; ++a) {
+              if (n[a] < kWallCells && nd.v[a] < 0) nd.v[a] = 0;
+              if (n[a] > domain_cells_[a] - kWallCells && nd.v[a] > 0) nd.v[a] = 0;
             }
           });
       },
@@ -211,15 +330,18 @@ void Solver::clamp_to_domain() {
         for (std::size_t p = b; p < e; ++p) particles_.x[p] = particles_.x[p].cwiseMax(lo).cwiseMin(hi);
       },
       opt_.serial);
+  for (GridShell& g : grid_shells_) {
+    for (Vec3& x : g.shell->x) x = x.cwiseMax(lo).cwiseMin(hi);
+    for (Vec3& x : g.contact->x) x = x.cwiseMax(lo).cwiseMin(hi);
+  }
 }
 
 double Solver::stable_dt() const {
   const ShotSettings& s = scene_.shot;
   double dt = std::min(s.dt_max, shell_dt_);
   const std::size_t n = particles_.size();
-  if (n == 0) return dt;
   double vmax = 0, cmax = 0;
-  {
+  if (n > 0) {
     const std::size_t chunks = (n + kParticleGrain - 1) / kParticleGrain;
     std::vector<double> vm(chunks, 0.0), cm(chunks, 0.0);
     parallel_for(
@@ -240,6 +362,8 @@ double Solver::stable_dt() const {
     vmax = *std::max_element(vm.begin(), vm.end());
     cmax = *std::max_element(cm.begin(), cm.end());
   }
+  for (const GridShell& g : grid_shells_)
+    for (const Vec3& v : g.shell->v) vmax = std::max(vmax, static_cast<double>(v.norm()));
   for (const Collider& c : colliders_) vmax = std::max(vmax, c.max_speed(time_));
   if (vmax > 0) dt = std::min(dt, s.cfl * s.dx / vmax);
   if (cmax > 0) dt = std::min(dt, s.cfl * s.dx / cmax);
@@ -337,6 +461,17 @@ void Solver::measure(FrameStats& s) const {
     s.shell_max_strain = std::max(s.shell_max_strain, sh->max_strain());
   }
   s.shell_plastic_work = plastic_work_;
+  for (std::size_t i = 0; i < shells_.size(); ++i) {
+    const ShellObject& sh = *shells_[i];
+    for (std::size_t j = 0; j < sh.size(); ++j) s.shell_momentum += static_cast<double>(sh.mass[j]) * sh.v[j].cast<double>();
+    if (!contacts_[i]) continue;
+    const ShellContact& c = *contacts_[i];
+    s.contact_particles += c.num_sites();
+    s.contact_energy += c.energy(sh.x.data(), opt_.serial);
+  }
+  s.contact_compressed = contact_step_.compressed;
+  s.contact_sliding = contact_step_.sliding;
+  s.friction_work = friction_work_;
   s.kinetic_energy = total.ke;
   s.elastic_energy = total.pe;
   s.mass = total.m;
@@ -353,6 +488,29 @@ int Solver::preroll(const PrerollSettings& p) {
   for (const auto& sh : shells_)
     for (const PointLoadDesc& pl : sh->desc().point_loads) fref = std::max(fref, pl.force.norm());
   if (fref <= 0) fref = 1;
+  if (p.method == PrerollSettings::Method::Static) {
+    // Shells do not touch each other in the pre-roll (as in the dynamic one), so each
+    // settles on its own; the residual criterion is the same as below.
+    int iterations = 0;
+    for (auto& sh : shells_) {
+      const StaticSolveResult r =
+          sh->settle(scene_.shot.gravity, time_, p.tolerance * fref, p.max_steps, opt_.serial);
+      if (!r.converged) {
+        std::ostringstream os;
+        os << "pre-roll did not settle shell '" << sh->name() << "' in " << r.iterations
+           << " iterations: residual " << r.residual << " N = " << r.residual / fref
+           << " x the reference force " << fref << " N, tolerance " << p.tolerance;
+        if (r.stalled)
+          os << "; no progress in the last " << StaticSolveOptions().stall_iterations
+             << " iterations: is there an equilibrium (pins holding the shell)?";
+        else
+          os << " (preroll.max_steps = " << p.max_steps << ")";
+        throw SimulationError(os.str());
+      }
+      iterations = std::max(iterations, r.iterations);
+    }
+    return iterations;
+  }
   double ke_prev = 0;
   for (int step = 1; step <= p.max_steps; ++step) {
     double residual = 0, ke = 0;

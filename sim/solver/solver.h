@@ -9,9 +9,11 @@
 #include <vector>
 
 #include "sim/collider/collider.h"
+#include "sim/contact/shell_transfer.h"
 #include "sim/mpm/constitutive.h"
 #include "sim/mpm/particles.h"
 #include "sim/mpm/sparse_grid.h"
+#include "sim/mpm/transfer.h"
 #include "sim/scene/scene.h"
 #include "sim/solver/frame_stats.h"
 #include "sim/shell/shell_object.h"
@@ -56,11 +58,24 @@ class Solver {
   const Scene& scene() const { return scene_; }
   std::vector<std::unique_ptr<ShellObject>>& shells() { return shells_; }
   const std::vector<std::unique_ptr<ShellObject>>& shells() const { return shells_; }
+  /// Shells whose control points are MPM particles (contact on), in scene order.
+  std::vector<GridShell>& grid_shells() { return grid_shells_; }
+  const std::vector<GridShell>& grid_shells() const { return grid_shells_; }
+  /// Whether shell i has contact (its control points live on the grid).
+  bool shell_on_grid(std::size_t i) const { return contacts_[i] != nullptr; }
+  /// Contact particles of shell i (null without contact).
+  ShellContact* contact(std::size_t i) { return contacts_[i].get(); }
+  const ShellContact* contact(std::size_t i) const { return contacts_[i].get(); }
+  /// Work dissipated by sliding friction between shells so far [J] (checkpointed).
+  double friction_work() const { return friction_work_; }
+  void set_friction_work(double w) { friction_work_ = w; }
   /// Plastic work dissipated by denting so far [J] (part of the checkpointed state).
   double shell_plastic_work() const { return plastic_work_; }
   void set_shell_plastic_work(double w) { plastic_work_ = w; }
-  /// Settles the shells to static equilibrium (damped dynamic relaxation with kinetic
-  /// damping) without advancing time; returns the number of steps taken.
+  /// Settles the shells to static equilibrium without advancing time: p.method Static
+  /// minimises the energy of each shell in double precision (ShellObject::settle; returns
+  /// the largest iteration count), Dynamic runs damped dynamic relaxation with kinetic
+  /// damping (returns the number of steps). Velocities are zero afterwards.
   /// Throws SimulationError when the residual does not fall below the tolerance.
   int preroll(const PrerollSettings& p);
 
@@ -78,6 +93,10 @@ class Solver {
   void project_plasticity();
   void emit();
   void clamp_to_domain();
+  void setup_contact();
+  void apply_walls();
+  void add_grid_stages();
+  TransferParams transfer_params();
 
   Scene scene_;
   SolverOptions opt_;
@@ -90,6 +109,12 @@ class Solver {
   std::vector<Stage> stages_;
   std::vector<std::unique_ptr<ShellObject>> shells_;
   std::vector<std::vector<Vec3>> shell_forces_;
+  std::vector<std::unique_ptr<ShellContact>> contacts_;  ///< per shell; null: no contact
+  std::vector<GridShell> grid_shells_;
+  ShellPointTable shell_table_;
+  std::vector<Vec3> shell_points_;  ///< binned positions of the grid shells' points
+  ContactStepStats contact_step_;   ///< the last step's return mapping
+  double friction_work_ = 0;
   double shell_dt_ = 1e300;
   double plastic_work_ = 0;
   double time_ = 0, dt_ = 0;

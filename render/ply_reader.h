@@ -1,0 +1,23 @@
+// Reading back the binary PLY caches a run writes (particles.####.ply, shell meshes),
+// fast and strictly: anything but little-endian binary with float x, y, z is refused.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "render/preview_scene.h"
+
+namespace shellmpm {
+
+struct PlyMesh {
+  std::vector<Vec3f> positions;
+  std::vector<Vec3f> normals;               ///< empty unless the file has nx, ny, nz
+  std::vector<Eigen::Vector3i> triangles;   ///< empty for point clouds
+};
+
+/// Reads vertices (x, y, z and, when present, nx, ny, nz) and triangle faces.
+/// @throws std::runtime_error whose message starts with `path`: missing or unreadable file,
+///         not PLY, not binary little-endian, no float x/y/z, a face that is not a triangle or
+///         indexes past the vertices, a non-finite coordinate, or a truncated body.
+PlyMesh read_ply(const std::string& path);
+
+}  // namespace shellmpm

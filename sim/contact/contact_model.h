@@ -1,0 +1,137 @@
+// Contact elasticity and Coulomb friction of one contact particle (Guo et al. 2018,
+// supplement sections 4-6; Jiang, Gast, Teran 2017 for the QR formulation).
+//
+// A contact particle sits at a fixed parametric site of a shell. Its elastic
+// deformation has the columns D = [a_1, a_2, a3E]: the surface tangents (from the control
+// points) and its own normal column a3E (advected with the grid). QR of D by
+// Gram-Schmidt, q_3 = q_1 x q_2, gives R = Q^T D upper triangular; only its third column
+// s = (r13, r23, r33) = Q^T a3E enters the energy:
+//   psi = gamma/2 (s1^2 + s2^2) + f(s3),  f(x) = k_c/3 (1 - x)^3 for x <= 1, else 0.
+// s3 < 1 is compression of the normal column (contact), (s1, s2) its shear.
+#pragma once
+#include <cmath>
+
+#include "sim/core/types.h"
+
+namespace shellmpm {
+
+/// Contact material of a shell: shear stiffness gamma [Pa], normal stiffness k_c [Pa],
+/// Coulomb friction coefficient c_F.
+struct ContactParams {
+  double gamma = 0;
+  double kc = 0;
+  double friction = 0;
+};
+
+template <class T>
+struct ContactFrameT {
+  using V3 = Eigen::Matrix<T, 3, 1>;
+  V3 q[3];       ///< orthonormal frame: q1 along a_1, q3 the unit normal
+  T r11, r12, r22;  ///< in-plane block of R
+  V3 s;          ///< third column of R: Q^T a3E
+};
+
+/// Gram-Schmidt QR of [a1, a2, a3E] (a1, a2 must be independent).
+template <class T>
+ContactFrameT<T> contact_frame(const Eigen::Matrix<T, 3, 1>& a1, const Eigen::Matrix<T, 3, 1>& a2,
+                               const Eigen::Matrix<T, 3, 1>& a3e) {
+  ContactFrameT<T> f;
+  f.r11 = a1.norm();
+  f.q[0] = a1 / f.r11;
+  f.r12 = f.q[0].dot(a2);
+  const Eigen::Matrix<T, 3, 1> u = a2 - f.r12 * f.q[0];
+  f.r22 = u.norm();
+  f.q[1] = u / f.r22;
+  f.q[2] = f.q[0].cross(f.q[1]);
+  f.s = Eigen::Matrix<T, 3, 1>(f.q[0].dot(a3e), f.q[1].dot(a3e), f.q[2].dot(a3e));
+  return f;
+}
+
+/// psi(s) [Pa = J/m^3]. (The supplement's f and gamma term.)
+template <class T>
+T contact_energy_density(const Eigen::Matrix<T, 3, 1>& s, const ContactParams& p) {
+  const T g = static_cast<T>(p.gamma), kc = static_cast<T>(p.kc);
+  T e = g / 2 * (s[0] * s[0] + s[1] * s[1]);
+  if (s[2] < 1) {
+    const T c = 1 - s[2];
+    e += kc / 3 * c * c * c;
+  }
+  return e;
+}
+
+/// d psi / d s.
+template <class T>
+Eigen::Matrix<T, 3, 1> contact_dpsi_ds(const Eigen::Matrix<T, 3, 1>& s, const ContactParams& p) {
+  const T g = static_cast<T>(p.gamma), kc = static_cast<T>(p.kc);
+  const T c = s[2] < 1 ? 1 - s[2] : T(0);
+  return Eigen::Matrix<T, 3, 1>(g * s[0], g * s[1], -kc * c * c);
+}
+
+/// Gradient of psi with respect to the columns of D: G.col(0) = dpsi/da1,
+/// G.col(1) = dpsi/da2, G.col(2) = dpsi/da3E. Equal to tau D^-T (tau the Kirchhoff
+/// stress), written without D^-1: G.col(2) = Q dpsi/ds and G.col(beta) = m_beta q3 with
+/// m = R2^-1 l, l_beta = s_beta (gamma s3 - f'(s3)) (the rows of L in B = A + L, where
+/// A = P R^T and B is the symmetric eq. (21) stress in the q basis). No division by s3,
+/// so it stays finite for any compression. Returns psi.
+template <class T>
+T contact_gradient(const Eigen::Matrix<T, 3, 1>& a1, const Eigen::Matrix<T, 3, 1>& a2,
+                   const Eigen::Matrix<T, 3, 1>& a3e, const ContactParams& p,
+                   Eigen::Matrix<T, 3, 3>* G) {
+  const ContactFrameT<T> f = contact_frame(a1, a2, a3e);
+  const T psi = contact_energy_density(f.s, p);
+  if (G) {
+    const Eigen::Matrix<T, 3, 1> d = contact_dpsi_ds(f.s, p);
+    const T k = static_cast<T>(p.gamma) * f.s[2] - d[2];
+    const T l1 = f.s[0] * k, l2 = f.s[1] * k;
+    const T m2 = l2 / f.r22;
+    const T m1 = (l1 - f.r12 * m2) / f.r11;
+    G->col(0) = m1 * f.q[2];
+    G->col(1) = m2 * f.q[2];
+    G->col(2) = d[0] * f.q[0] + d[1] * f.q[1] + d[2] * f.q[2];
+  }
+  return psi;
+}
+
+/// Kirchhoff stress tau = Q B Q^T, B the supplement's eq. (23) (with the (3,3) entry
+/// f'(s3) s3, see METHOD.md).
+template <class T>
+Eigen::Matrix<T, 3, 3> contact_kirchhoff(const Eigen::Matrix<T, 3, 1>& a1,
+                                         const Eigen::Matrix<T, 3, 1>& a2,
+                                         const Eigen::Matrix<T, 3, 1>& a3e, const ContactParams& p) {
+  const ContactFrameT<T> f = contact_frame(a1, a2, a3e);
+  const Eigen::Matrix<T, 3, 1> d = contact_dpsi_ds(f.s, p);
+  const T g = static_cast<T>(p.gamma);
+  const T s1 = f.s[0], s2 = f.s[1], s3 = f.s[2];
+  Eigen::Matrix<T, 3, 3> B;
+  B << g * s1 * s1, g * s1 * s2, g * s1 * s3,  //
+      g * s1 * s2, g * s2 * s2, g * s2 * s3,   //
+      g * s1 * s3, g * s2 * s3, d[2] * s3;
+  Eigen::Matrix<T, 3, 3> Q;
+  for (int i = 0; i < 3; ++i) Q.col(i) = f.q[i];
+  return Q * B * Q.transpose();
+}
+
+/// What the return mapping did to one particle.
+enum class ContactState : unsigned char { Separated = 0, Sticking = 1, Sliding = 2 };
+
+/// Coulomb return mapping on s (supplement sec. 6): separated (s3 > 1) -> (0, 0, 1);
+/// compressed with gamma |(s1, s2)| > c_F k_c (1 - s3)^2 -> shear scaled onto that bound.
+template <class T>
+ContactState contact_return_map(Eigen::Matrix<T, 3, 1>& s, const ContactParams& p) {
+  if (s[2] >= 1) {
+    s = Eigen::Matrix<T, 3, 1>(0, 0, 1);
+    return ContactState::Separated;
+  }
+  const T c = 1 - s[2];
+  const T bound = static_cast<T>(p.friction * p.kc / p.gamma) * c * c;
+  const T n = std::sqrt(s[0] * s[0] + s[1] * s[1]);
+  if (n > bound) {
+    const T k = n > 0 ? bound / n : T(0);
+    s[0] *= k;
+    s[1] *= k;
+    return ContactState::Sliding;
+  }
+  return ContactState::Sticking;
+}
+
+}  // namespace shellmpm

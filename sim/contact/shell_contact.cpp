@@ -1,0 +1,211 @@
+#include "sim/contact/shell_contact.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/core/check.h"
+#include "sim/core/parallel.h"
+#include "sim/shell/shell_quadrature.h"
+
+namespace shellmpm {
+namespace {
+constexpr std::size_t kGrain = 2048;
+constexpr Real kCompressionTolerance = Real(1e-4);
+constexpr Real kSeparationTolerance = Real(1e-6);
+
+// Sums f(i) over [0, n) in fixed chunks combined in order (same result for any threads).
+template <class T, class F>
+T chunked_sum(std::size_t n, bool serial, F f) {
+  const std::size_t chunks = (n + kGrain - 1) / kGrain;
+  std::vector<T> part(chunks, T{});
+  parallel_for(
+      n, kGrain,
+      [&](std::size_t b, std::size_t e) {
+        T acc{};
+        for (std::size_t i = b; i < e; ++i) acc += f(i);
+        part[b / kGrain] = acc;
+      },
+      serial);
+  T total{};
+  for (const T& v : part) total += v;
+  return total;
+}
+}  // namespace
+
+ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& rest,
+                           double thickness, int samples, const ContactParams& params)
+    : params_(params) {
+  const TriangleQuadrature rule = triangle_quadrature(samples);
+  const int nf = basis.num_faces();
+  const std::size_t ns = static_cast<std::size_t>(nf) * rule.points.size();
+  off.reserve(ns + 1);
+  off.push_back(0);
+  x.resize(ns);
+  a3e.resize(ns);
+  G3.assign(ns, Vec3::Zero());
+  G1_.assign(ns, Vec3::Zero());
+  G2_.assign(ns, Vec3::Zero());
+  volume.resize(ns);
+  state.assign(ns, static_cast<std::uint8_t>(ContactState::Separated));
+  C.assign(rest.size(), Mat3::Zero());
+  BasisPoint bp;
+  std::size_t p = 0;
+  for (int f = 0; f < nf; ++f)
+    for (std::size_t q = 0; q < rule.points.size(); ++q, ++p) {
+      basis.evaluate(f, rule.points[q].x(), rule.points[q].y(), bp);
+      Vec3d pos = Vec3d::Zero(), a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
+      for (std::size_t k = 0; k < bp.ctrl.size(); ++k) {
+        const Vec3d& r = rest[bp.ctrl[k]];
+        pos += bp.N[k] * r;
+        a1 += bp.N1[k] * r;
+        a2 += bp.N2[k] * r;
+        idx.push_back(static_cast<std::uint32_t>(bp.ctrl[k]));
+        N.push_back(static_cast<Real>(bp.N[k]));
+        N1.push_back(static_cast<Real>(bp.N1[k]));
+        N2.push_back(static_cast<Real>(bp.N2[k]));
+      }
+      off.push_back(static_cast<std::uint32_t>(idx.size()));
+      const Vec3d n = a1.cross(a2);
+      const double jac = n.norm();
+      SHELLMPM_CHECK(jac > 0, << "degenerate rest tangents at face " << f);
+      x[p] = pos.cast<Real>();
+      a3e[p] = (n / jac).cast<Real>();  // rest normal: s = (0, 0, 1)
+      volume[p] = static_cast<Real>(rule.weights[q] * jac * thickness);
+    }
+  // Transpose the stencils (counting sort by control point; sites stay ascending).
+  const std::size_t nc = rest.size();
+  toff.assign(nc + 1, 0);
+  for (std::uint32_t j : idx) ++toff[j + 1];
+  for (std::size_t j = 0; j < nc; ++j) toff[j + 1] += toff[j];
+  tsite.resize(idx.size());
+  tN1.resize(idx.size());
+  tN2.resize(idx.size());
+  std::vector<std::uint32_t> cur(toff.begin(), toff.end() - 1);
+  for (std::size_t s = 0; s < ns; ++s)
+    for (std::uint32_t k = off[s]; k < off[s + 1]; ++k) {
+      const std::uint32_t at = cur[idx[k]]++;
+      tsite[at] = static_cast<std::uint32_t>(s);
+      tN1[at] = N1[k];
+      tN2[at] = N2[k];
+    }
+}
+
+void ShellContact::tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2) const {
+  // Differences to the first control point: the dN sum to zero, so this is exact and
+  // keeps float precision far from the origin.
+  const Vec3 ref = ctrl[idx[off[p]]];
+  a1.setZero();
+  a2.setZero();
+  for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
+    const Vec3 d = ctrl[idx[k]] - ref;
+    a1 += N1[k] * d;
+    a2 += N2[k] * d;
+  }
+}
+
+void ShellContact::update_positions(const Vec3* ctrl, bool serial) {
+  parallel_for(
+      num_sites(), kGrain,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t p = b; p < e; ++p) {
+          const Vec3 ref = ctrl[idx[off[p]]];
+          Vec3 d = Vec3::Zero();
+          for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) d += N[k] * (ctrl[idx[k]] - ref);
+          x[p] = ref + d;
+        }
+      },
+      serial);
+}
+
+double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
+  const double e = chunked_sum<double>(num_sites(), serial, [&](std::size_t p) {
+    Vec3 a1, a2;
+    tangents(ctrl, p, a1, a2);
+    Mat3 G;
+    const Real psi = contact_gradient<Real>(a1, a2, a3e[p], params_, &G);
+    const Real V = volume[p];
+    G1_[p] = V * G.col(0);
+    G2_[p] = V * G.col(1);
+    G3[p] = G.col(2);
+    return static_cast<double>(V * psi);
+  });
+  parallel_for(
+      num_control_points(), kGrain,
+      [&](std::size_t b, std::size_t en) {
+        for (std::size_t j = b; j < en; ++j) {
+          Vec3 acc = Vec3::Zero();
+          for (std::uint32_t k = toff[j]; k < toff[j + 1]; ++k)
+            acc += tN1[k] * G1_[tsite[k]] + tN2[k] * G2_[tsite[k]];
+          f[j] -= acc;
+        }
+      },
+      serial);
+  return e;
+}
+
+double ShellContact::energy(const Vec3* ctrl, bool serial) const {
+  return chunked_sum<double>(num_sites(), serial, [&](std::size_t p) {
+    Vec3 a1, a2;
+    tangents(ctrl, p, a1, a2);
+    return static_cast<double>(volume[p] * contact_gradient<Real>(a1, a2, a3e[p], params_, nullptr));
+  });
+}
+
+ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
+  struct Acc {
+    std::size_t compressed = 0, sliding = 0;
+    double friction = 0, separation = 0;
+    Acc& operator+=(const Acc& o) {
+      compressed += o.compressed;
+      sliding += o.sliding;
+      friction += o.friction;
+      separation += o.separation;
+      return *this;
+    }
+  };
+  const Acc a = chunked_sum<Acc>(num_sites(), serial, [&](std::size_t p) {
+    Vec3 a1, a2;
+    tangents(ctrl, p, a1, a2);
+    // The frame in double: in float |q3| = 1 - O(1e-7) with a bias, and rebuilding a3E from
+    // it every step would shrink a sticking column steadily (a spurious compression).
+    const ContactFrameT<double> fr =
+        contact_frame<double>(a1.cast<double>(), a2.cast<double>(), a3e[p].cast<double>());
+    Vec3 s = fr.s.cast<Real>();
+    // Round-off separation: a column within kSeparationTolerance of its rest length is
+    // treated as separated (stored energy below k_c 1e-18 / 3).
+    if (s[2] > Real(1) - kSeparationTolerance) s[2] = std::max(s[2], Real(1));
+    const Real psi0 = contact_energy_density<Real>(s, params_);
+    const Real slip0 = std::hypot(s[0], s[1]);
+    const ContactState st = contact_return_map<Real>(s, params_);
+    a3e[p] = (static_cast<double>(s[0]) * fr.q[0] + static_cast<double>(s[1]) * fr.q[1] +
+              static_cast<double>(s[2]) * fr.q[2])
+                 .cast<Real>();
+    state[p] = static_cast<std::uint8_t>(st);
+    Acc r;
+    const double V = static_cast<double>(volume[p]);
+    if (st == ContactState::Separated) {
+      r.separation = V * static_cast<double>(psi0 - contact_energy_density<Real>(s, params_));
+    } else {
+      // Counted as in contact when the compression is above round-off.
+      r.compressed = s[2] < Real(1) - kCompressionTolerance ? 1 : 0;
+      if (st == ContactState::Sliding) {
+        // Plastic work: shear stress on the cone times the slip (the return mapping's
+        // analogue of sigma_y * delta eps_p; the trial energy's excess over it is a
+        // discretization term of order dt).
+        const Real slip1 = std::hypot(s[0], s[1]);
+        r.sliding = 1;
+        r.friction = V * static_cast<double>(params_.gamma) * static_cast<double>(slip1) *
+                     static_cast<double>(slip0 - slip1);
+      }
+    }
+    return r;
+  });
+  ContactStepStats out;
+  out.compressed = a.compressed;
+  out.sliding = a.sliding;
+  out.friction_work = a.friction;
+  out.separation_work = a.separation;
+  return out;
+}
+
+}  // namespace shellmpm

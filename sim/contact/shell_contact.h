@@ -1,0 +1,71 @@
+// Contact particles of one shell (the supplement's type (iii) particles): fixed
+// parametric sites on every triangle of the control mesh, each with its rest volume,
+// its position and tangents interpolated from the control points, and its own normal
+// column a3E advected with the grid (METHOD.md, "Contact elasticity and friction").
+// Also holds the control points' APIC matrices, which exist only when the shell's
+// control points are MPM particles.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "sim/contact/contact_model.h"
+#include "sim/core/types.h"
+#include "sim/shell/loop_basis.h"
+
+namespace shellmpm {
+
+/// Per-step counts of what the friction return mapping did.
+struct ContactStepStats {
+  std::size_t compressed = 0;  ///< particles with s3 < 1 after the projection
+  std::size_t sliding = 0;     ///< particles whose shear was scaled onto the Coulomb cone
+  double friction_work = 0;    ///< energy removed by sliding [J]
+  double separation_work = 0;  ///< shear energy dropped by separated particles [J]
+};
+
+class ShellContact {
+ public:
+  /// samples: sites per triangle (1, 3, 6 or 7: the Dunavant points, whose weights give
+  /// each site's share of the triangle's rest area). Volume = area share * thickness.
+  ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& rest, double thickness,
+               int samples, const ContactParams& params);
+
+  std::size_t num_sites() const { return volume.size(); }
+  std::size_t num_control_points() const { return C.size(); }
+  const ContactParams& params() const { return params_; }
+
+  /// Site positions x from the control points.
+  void update_positions(const Vec3* ctrl, bool serial);
+  /// Contact energy sum V psi [J]. Stores dpsi/da3E per site in `G3` (for the grid's normal
+  /// force) and adds the tangential part, f_j = -sum_p V_p sum_beta dN_j/dxi_beta
+  /// dpsi/da_beta, to the control-point forces f (deterministic gather per point).
+  double forces(const Vec3* ctrl, Vec3* f, bool serial);
+  /// Energy only [J].
+  double energy(const Vec3* ctrl, bool serial) const;
+  /// Coulomb return mapping with the current control points and a3E; rewrites a3E.
+  ContactStepStats return_map(const Vec3* ctrl, bool serial);
+  /// Tangents a_1, a_2 of site p.
+  void tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2) const;
+
+  // Per site.
+  std::vector<Vec3> x;     ///< position (from the control points) [m]
+  std::vector<Vec3> a3e;   ///< elastic normal column
+  std::vector<Vec3> G3;    ///< dpsi/da3E from the last forces() call [Pa]
+  std::vector<Real> volume;  ///< rest volume [m^3]
+  std::vector<std::uint8_t> state;  ///< ContactState after the last return mapping
+  // Per control point.
+  std::vector<Mat3> C;     ///< APIC affine velocity matrix [1/s]
+
+  // Site stencils (CSR): control points k in [off[p], off[p+1]).
+  std::vector<std::uint32_t> off, idx;
+  std::vector<Real> N, N1, N2;
+
+ private:
+  ContactParams params_;
+  // Transposed stencils for the force gather: for control point j, entries
+  // [toff[j], toff[j+1]) name a site and its dN/dxi.
+  std::vector<std::uint32_t> toff, tsite;
+  std::vector<Real> tN1, tN2;
+  std::vector<Vec3> G1_, G2_;
+};
+
+}  // namespace shellmpm

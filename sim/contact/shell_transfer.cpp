@@ -1,0 +1,200 @@
+#include "sim/contact/shell_transfer.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "sim/collider/collider.h"
+#include "sim/core/check.h"
+#include "sim/core/parallel.h"
+
+namespace shellmpm {
+
+void ShellPointTable::build(const std::vector<GridShell>& shells) {
+  shell_.clear();
+  local_.clear();
+  for (std::size_t s = 0; s < shells.size(); ++s)
+    for (std::size_t j = 0; j < shells[s].shell->size(); ++j) {
+      shell_.push_back(static_cast<std::uint16_t>(s));
+      local_.push_back(static_cast<std::uint32_t>(j));
+    }
+  num_ctrl_ = static_cast<std::uint32_t>(shell_.size());
+  for (std::size_t s = 0; s < shells.size(); ++s)
+    for (std::size_t p = 0; p < shells[s].contact->num_sites(); ++p) {
+      shell_.push_back(static_cast<std::uint16_t>(s));
+      local_.push_back(static_cast<std::uint32_t>(p));
+    }
+}
+
+void ShellPointTable::positions(const std::vector<GridShell>& shells, std::vector<Vec3>& out) const {
+  out.clear();
+  out.reserve(size());
+  for (const GridShell& g : shells) out.insert(out.end(), g.shell->x.begin(), g.shell->x.end());
+  for (const GridShell& g : shells) out.insert(out.end(), g.contact->x.begin(), g.contact->x.end());
+}
+
+void prescribe_pins(ShellObject& sh, double t, double dt, std::vector<std::uint8_t>& held) {
+  const ShellDesc& d = sh.desc();
+  held.assign(sh.size(), 0);
+  if (d.pins.empty()) return;
+  std::vector<RigidPose> poses(d.pins.size());
+  std::vector<char> released(d.pins.size());
+  for (std::size_t p = 0; p < poses.size(); ++p) {
+    poses[p] = keyframe_pose(d.pins[p].keyframes, t + dt);
+    released[p] = d.pins[p].release_time >= 0 && t >= d.pins[p].release_time;
+  }
+  const Real h = static_cast<Real>(dt);
+  for (std::size_t i = 0; i < sh.size(); ++i) {
+    if (!sh.pin_mask[i] || released[sh.pin_of[i]]) continue;
+    const Vec3 target = poses[sh.pin_of[i]].apply(sh.rest[i]).cast<Real>();
+    held[i] = sh.pin_mask[i];
+    for (int a = 0; a < 3; ++a)
+      if (held[i] & (1u << a)) sh.v[i][a] = (target[a] - sh.x[i][a]) / h;
+  }
+}
+
+namespace {
+
+// Slice of block b's order entries holding shell points of one kind: [lo, hi).
+std::pair<std::uint32_t, std::uint32_t> slice(const SparseGrid& grid, std::size_t b,
+                                              std::uint32_t lo_index, std::uint32_t hi_index) {
+  const auto* o = grid.order.data();
+  const std::uint32_t s0 = grid.pblock_start[b], s1 = grid.pblock_start[b + 1];
+  const auto lo = std::lower_bound(o + s0, o + s1, lo_index) - o;
+  const auto hi = std::lower_bound(o + lo, o + s1, hi_index) - o;
+  return {static_cast<std::uint32_t>(lo), static_cast<std::uint32_t>(hi)};
+}
+
+}  // namespace
+
+void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
+                     const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf) {
+  const auto [lo, hi] = slice(grid, b, 0, table.num_control_points());
+  if (lo == hi) return;
+  const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
+  const Real dx = static_cast<Real>(grid.dx());
+  for (std::uint32_t s = lo; s < hi; ++s) {
+    const std::uint32_t g = grid.order[s];
+    const GridShell& gs = shells[table.shell(g)];
+    const std::uint32_t j = table.local(g);
+    const ShellObject& sh = *gs.shell;
+    const Real m = sh.mass[j];
+    const QuadraticWeights W(grid.grid_coord(sh.x[j]));
+    const Mat3 A = (m * dx) * gs.contact->C[j];  // world offset = dx (node - fx)
+    const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
+    const Vec3 base = m * sh.v[j] + dt * gs.force[j] - A * fx;
+    const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+    for (int i = 0; i < 3; ++i)
+      for (int jj = 0; jj < 3; ++jj)
+        for (int k = 0; k < 3; ++k) {
+          const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];
+          const Vec3 mom = w * (base + A * Vec3(Real(i), Real(jj), Real(k)));
+          GridNode& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
+          nd.m += w * m;
+          nd.v[0] += mom[0];
+          nd.v[1] += mom[1];
+          nd.v[2] += mom[2];
+        }
+  }
+}
+
+void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
+                     std::vector<GridShell>& shells, Real dt, std::size_t b, const GridNode* buf) {
+  const std::uint32_t nc = table.num_control_points();
+  const auto [lo, hi] = slice(grid, b, 0, static_cast<std::uint32_t>(table.size()));
+  if (lo == hi) return;
+  const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
+  const Real dx = static_cast<Real>(grid.dx());
+  for (std::uint32_t s = lo; s < hi; ++s) {
+    const std::uint32_t g = grid.order[s];
+    GridShell& gs = shells[table.shell(g)];
+    const std::uint32_t j = table.local(g);
+    if (g < nc) {
+      ShellObject& sh = *gs.shell;
+      const QuadraticWeights W(grid.grid_coord(sh.x[j]));
+      const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+      const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
+      Vec3 v = Vec3::Zero();
+      Mat3 B = Mat3::Zero();
+      for (int i = 0; i < 3; ++i)
+        for (int jj = 0; jj < 3; ++jj)
+          for (int k = 0; k < 3; ++k) {
+            const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];
+            const GridNode& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
+            const Vec3 vn(nd.v[0], nd.v[1], nd.v[2]);
+            v += w * vn;
+            B += (w * vn) * (Vec3(Real(i), Real(jj), Real(k)) - fx).transpose();
+          }
+      gs.contact->C[j] = (Real(4) / dx) * B;  // B D^-1 with B in grid units times dx
+      const std::uint8_t held = gs.held[j];
+      for (int a = 0; a < 3; ++a)
+        if (!(held & (1u << a))) sh.v[j][a] = v[a];
+      sh.x[j] += dt * sh.v[j];
+    } else {
+      ShellContact& c = *gs.contact;
+      auto node = [&](int i, int jj, int k) -> const GridNode& {
+        return buf[pad_node(i - bc[0], jj - bc[1], k - bc[2])];
+      };
+      const SiteStencil st =
+          site_stencil(grid, c.x[j], [&](int i, int jj, int k) { return node(i, jj, k).m; });
+      if (!st.any) continue;
+      Mat3 gradv = Mat3::Zero();
+      int n = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int jj = 0; jj < 3; ++jj)
+          for (int k = 0; k < 3; ++k, ++n) {
+            if (!st.massive[n]) continue;
+            const GridNode& nd = node(st.base[0] + i, st.base[1] + jj, st.base[2] + k);
+            gradv += Vec3(nd.v[0], nd.v[1], nd.v[2]) * st.grad[n].transpose();
+          }
+      c.a3e[j] += dt * (gradv * c.a3e[j]);
+    }
+  }
+}
+
+void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
+                           const std::vector<GridShell>& shells, Real dt, bool serial) {
+  const std::uint32_t nc = table.num_control_points();
+  const auto ns = static_cast<std::uint32_t>(table.size());
+  grid.scatter_grid_to_buffers(serial);
+  parallel_for(
+      grid.num_particle_blocks(), 1,
+      [&](std::size_t bb, std::size_t be) {
+        for (std::size_t b = bb; b < be; ++b) {
+          auto& buf = grid.pblock_buf[b];
+          const auto [lo, hi] = slice(grid, b, nc, ns);
+          Real mass[kPadNodes];
+          for (int n = 0; n < kPadNodes; ++n) mass[n] = buf[n].m;
+          std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
+          if (lo == hi) continue;
+          const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
+          for (std::uint32_t s = lo; s < hi; ++s) {
+            const std::uint32_t g = grid.order[s];
+            const ShellContact& c = *shells[table.shell(g)].contact;
+            const std::uint32_t p = table.local(g);
+            const Vec3& G3 = c.G3[p];
+            if (G3.squaredNorm() == 0) continue;
+            auto at = [&](int i, int j, int k) { return pad_node(i - bc[0], j - bc[1], k - bc[2]); };
+            const SiteStencil st =
+                site_stencil(grid, c.x[p], [&](int i, int j, int k) { return mass[at(i, j, k)]; });
+            if (!st.any) continue;
+            const Vec3 a3 = c.a3e[p];
+            const Real V = c.volume[p];
+            int n = 0;
+            for (int i = 0; i < 3; ++i)
+              for (int j = 0; j < 3; ++j)
+                for (int k = 0; k < 3; ++k, ++n) {
+                  if (!st.massive[n]) continue;
+                  const int id = at(st.base[0] + i, st.base[1] + j, st.base[2] + k);
+                  const Vec3 dv = (-dt * V * st.grad[n].dot(a3) / mass[id]) * G3;
+                  buf[id].v[0] += dv[0];
+                  buf[id].v[1] += dv[1];
+                  buf[id].v[2] += dv[2];
+                }
+          }
+        }
+      },
+      serial);
+  grid.gather_buffer_increments(serial);
+}
+
+}  // namespace shellmpm
