@@ -401,7 +401,7 @@ TEST_CASE("bad scenes name the file, line and key", "[scene]") {
     expect_error(kHead + "colider: []\n", 5, "colider",
                  {"unknown key 'colider' in the top level",
                   "(known: version, shot, materials, sources, colliders, shell_materials, shells, "
-                  "preroll, output)"});
+                  "preroll, output, render)"});
     expect_error(kHead + "  dxx: 0.2\n", 5, "shot.dxx",
                  {"unknown key 'dxx' in shot (known: frames, fps, cfl,"});
     expect_error(kHead + kSand + "sources:\n  - material: sand\n    colour: red\n", 9,
