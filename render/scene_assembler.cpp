@@ -10,6 +10,7 @@
 #include "io/atomic_file.h"
 #include "io/mesh_reader.h"
 #include "io/user_error.h"
+#include "render/particle_culling.h"
 #include "render/ply_reader.h"
 #include "render/tessellate.h"
 #include "sim/collider/collider.h"
@@ -370,6 +371,7 @@ PreviewScene SceneAssembler::assemble(int frame) const {
     ps.particles.radius = particle_radius_;
     ps.particles.color = bulk_color_;
     for (const Vec3f& p : ps.particles.positions) content.add(p.cast<double>());
+    cull_hidden_particles(ps.particles);  // buried ones can neither be seen nor cast shadows
   }
 
   // Colliders at the frame's time.
