@@ -35,8 +35,10 @@ class ShellObject {
   /// pinned components held at their pin pose at `time` (pre-roll). Positions, forces
   /// and the solve are in double (a temporary double copy of the Kirchhoff-Love data):
   /// float positions round by ulp(|x|) (1.5e-8 m at 0.2 m from the origin), a membrane
-  /// force noise of about E t ulp(|x|) per control point (3e-4 N for E = 1e7 Pa, t = 2 mm),
-  /// which can exceed the loads (measured in tests/sim/test_cantilever.cpp).
+  /// force noise of up to E t ulp(|x|) per control point. Measured on the cantilever of
+  /// tests/sim/test_cantilever.cpp (E = 1e7 Pa, t = 2 mm): 1e-4 N at the float-rounded
+  /// rest state, with the double kernel as with the float one, 2 to 8 times its nodal tip
+  /// loads; so the state itself, not the kernel's arithmetic, must be double.
   /// Newton-like L-BFGS with a finite-difference stiffness (static_solver.h); stops at
   /// max |free force component| < tolerance [N]. Writes x and zeroes v; the plastic
   /// state is kept (no return mapping).
