@@ -30,13 +30,35 @@ int check_command(const CommonArgs& a) {
     for (double t = sm.emit_t0(); t < sm.emit_t1(); t += step)
       sm.emit(t, std::min(step, sm.emit_t1() - t), [&](const Vec3d&) { ++emitted; });
   }
-  for (const auto& sh : solver.shells()) {
+  for (std::size_t si = 0; si < solver.shells().size(); ++si) {
+    const auto& sh = solver.shells()[si];
     const ShellMaterialDesc& m = scene.shell_materials[sh->desc().material];
     std::printf("shell %s: %zu control points, %zu output vertices, %d x %d quadrature points per "
                 "triangle, stable step %.3g s%s\n",
                 sh->name().c_str(), sh->size(), sh->limit_mesh().num_vertices(),
                 m.quadrature_inplane, m.quadrature_thickness, sh->stable_dt(s.cfl),
                 m.yield_stress > 0 ? ", denting" : "");
+    if (const ShellContact* c = solver.contact(si)) {
+      // Mean rest edge of the control mesh against dx (METHOD.md: keep them close; a grid
+      // much coarser than the mesh leaves gaps between shells in contact, a much finer
+      // one lets contact particles miss the control points' grid nodes).
+      double sum = 0;
+      std::size_t n = 0;
+      for (const auto& t : sh->triangles())
+        for (int e = 0; e < 3; ++e, ++n) sum += (sh->rest[t[e]] - sh->rest[t[(e + 1) % 3]]).norm();
+      const double h = n ? sum / static_cast<double>(n) : 0;
+      std::printf("  contact: %zu contact particles (%d per triangle), k_c %g Pa, gamma %g Pa, "
+                  "friction %g; mean edge %.3g m = %.2f dx\n",
+                  c->num_sites(), m.contact_samples, c->params().kc, c->params().gamma,
+                  c->params().friction, h, h / s.dx);
+      if (h > 2.0 * s.dx || h < 0.5 * s.dx)
+        std::printf("warning: shell %s: its mesh spacing (%.3g m) is %s than the grid spacing dx = "
+                    "%g m; keep them within a factor 2 (%s)\n",
+                    sh->name().c_str(), h, h > s.dx ? "much coarser" : "much finer", s.dx,
+                    h > s.dx ? "refine the mesh or raise dx" : "coarsen the mesh or lower dx");
+    } else {
+      std::printf("  contact: off (the shell moves on its own, without the grid)\n");
+    }
   }
   const std::size_t n0 = solver.particles().size();
   std::printf("particles: %zu at start, about %zu more emitted\n", n0, emitted);

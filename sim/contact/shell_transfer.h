@@ -4,15 +4,17 @@
 // to the grid with the kernel gradient and whose a3E is advected with the grid velocity
 // gradient (supplement sec. 2).
 //
-// Massless nodes: a contact particle's 27 stencil nodes need not all carry mass (a node
-// can be reached by the site but by no control point). Forces on such nodes would be
-// lost, and their velocity (zero) would corrupt the site's velocity gradient. Both
-// passes therefore use the gradient restricted to the nodes with mass and made to sum
-// to zero, grad~w_i = grad w_i - w_i c / W (W, c: sums of w and grad w over those
-// nodes). This is the gradient of the interpolation that gives massless nodes the
-// weighted mean velocity of the others; force and velocity gradient stay consistent
-// (the force is minus the energy gradient for that motion) and the force sums to zero,
-// so momentum is conserved exactly.
+// The velocity gradient at a contact particle (which has no mass) and the matching
+// normal force use a mass-weighted least-squares gradient over the particle's 27 stencil
+// nodes: with a_i = w_ip m_i, d_i = x_i - x_p, dbar = sum a_i d_i / sum a_i and
+// M = sum a_i (d_i - dbar)(d_i - dbar)^T, grad v = sum_i v_i (x) g_i, g_i = a_i M^-1 (d_i - dbar).
+// It is exact for linear velocity fields, equals the APIC gradient B D^-1 when all nodes
+// carry equal mass, sums to zero (the force conserves momentum) and gives nodes with
+// little mass little weight: the velocity change dt f_i / m_i = -dt V w_ip
+// (M^-1 (d_i - dbar) . a3E) dpsi/da3E does not grow as m_i -> 0 (a plain kernel gradient
+// would, when a node is reached by a light neighbour's tail only). The force is minus the
+// gradient of the contact energy for the motion a3E <- (I + sum u_i (x) g_i) a3E, so the
+// pair stays energy-consistent (tests/sim/test_contact_grid.cpp checks it).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -69,8 +71,8 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
 void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
                            const std::vector<GridShell>& shells, Real dt, bool serial);
 
-/// The 27 stencil nodes of a point with the mass-restricted, zero-sum kernel gradient
-/// (world units) described above; `massive[k]` false for nodes without mass.
+/// The 27 stencil nodes of a point with the mass-weighted gradient weights g_i described
+/// above (world units, 1/m); `massive[k]` false for nodes without mass (g = 0 there).
 struct SiteStencil {
   int base[3];
   Real w[27];
@@ -83,33 +85,37 @@ template <class MassFn>
 SiteStencil site_stencil(const SparseGrid& grid, const Vec3& x, MassFn mass) {
   SiteStencil st;
   const QuadraticWeights W(grid.grid_coord(x));
-  const Real inv_dx = static_cast<Real>(1.0 / grid.dx());
+  const Real dx = static_cast<Real>(grid.dx());
   for (int a = 0; a < 3; ++a) st.base[a] = W.base[a];
-  Real wsum = 0;
-  Vec3 gsum = Vec3::Zero();
+  Real a[27];
+  Vec3 d[27];
+  Real asum = 0;
+  Vec3 dsum = Vec3::Zero();
   int n = 0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < 3; ++k, ++n) {
         st.w[n] = W.w[0][i] * W.w[1][j] * W.w[2][k];
-        st.grad[n] = inv_dx * Vec3(W.dw[0][i] * W.w[1][j] * W.w[2][k],
-                                   W.w[0][i] * W.dw[1][j] * W.w[2][k],
-                                   W.w[0][i] * W.w[1][j] * W.dw[2][k]);
-        st.massive[n] = mass(W.base[0] + i, W.base[1] + j, W.base[2] + k) > 0;
-        if (st.massive[n]) {
-          wsum += st.w[n];
-          gsum += st.grad[n];
-        }
+        d[n] = dx * Vec3(Real(i) - W.fx[0], Real(j) - W.fx[1], Real(k) - W.fx[2]);
+        const Real m = mass(W.base[0] + i, W.base[1] + j, W.base[2] + k);
+        st.massive[n] = m > 0;
+        a[n] = st.massive[n] ? st.w[n] * m : Real(0);
+        asum += a[n];
+        dsum += a[n] * d[n];
       }
-  st.any = wsum > 0;
-  if (!st.any) return st;
-  const Vec3 c = gsum / wsum;
-  for (n = 0; n < 27; ++n) {
-    if (st.massive[n])
-      st.grad[n] -= st.w[n] * c;
-    else
-      st.grad[n].setZero();
+  st.any = asum > 0;
+  if (!st.any) {
+    for (n = 0; n < 27; ++n) st.grad[n].setZero();
+    return st;
   }
+  const Vec3 dbar = dsum / asum;
+  // Regularised by 1e-3 of the full-stencil moment (asum dx^2 / 4) in case the nodes with
+  // mass are (nearly) coplanar.
+  Mat3 M = (Real(2.5e-4) * asum * dx * dx) * Mat3::Identity();
+  for (n = 0; n < 27; ++n)
+    if (a[n] > 0) M += a[n] * (d[n] - dbar) * (d[n] - dbar).transpose();
+  const Mat3 Minv = M.inverse();
+  for (n = 0; n < 27; ++n) st.grad[n] = a[n] > 0 ? Vec3(a[n] * (Minv * (d[n] - dbar))) : Vec3::Zero();
   return st;
 }
 

@@ -1,0 +1,403 @@
+// Contact through the MPM grid, whole solver: momentum conservation, no pass-through
+// between sheets, no penetration of colliders, only-what-is-needed stages.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "sim/solver/solver.h"
+
+using namespace shellmpm;
+
+namespace {
+
+ShellMaterialDesc cloth(double friction = 0.3) {
+  ShellMaterialDesc m;
+  m.name = "cloth";
+  m.youngs_modulus = 2e5;
+  m.poisson_ratio = 0.3;
+  m.density = 300;
+  m.thickness = 1e-3;
+  m.friction = friction;
+  return m;
+}
+
+ShellDesc sheet(const std::string& name, double size, int res, const Vec3d& at) {
+  ShellDesc d;
+  d.name = name;
+  d.kind = ShellDesc::Kind::Sheet;
+  d.size[0] = d.size[1] = size;
+  d.resolution[0] = d.resolution[1] = res;
+  d.translate = at;
+  return d;
+}
+
+Scene contact_scene(double dx) {
+  Scene s;
+  s.path = "test";
+  s.shot.dx = dx;
+  s.shot.cfl = 0.5;
+  s.shot.fps = 48;
+  s.shot.domain_min = Vec3d(-1, -1, -1);
+  s.shot.domain_max = Vec3d(1, 1, 1);
+  s.shell_materials.push_back(cloth());
+  return s;
+}
+
+Vec3d total_momentum(const Solver& solver) {
+  FrameStats fs;
+  solver.measure(fs);
+  return fs.momentum + fs.shell_momentum;
+}
+
+bool contains(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+}  // namespace
+
+TEST_CASE("contact stages appear only when the scene calls for contact", "[contact]") {
+  Scene s = contact_scene(0.05);
+  s.shells.push_back(sheet("a", 0.4, 8, Vec3d(0, 0, 0)));
+  {
+    Solver solver(s);  // a lone shell, no colliders: no contact, no grid
+    const auto st = solver.stage_names();
+    CHECK_FALSE(contains(st, "contact"));
+    CHECK_FALSE(contains(st, "p2g"));
+    CHECK_FALSE(solver.shell_on_grid(0));
+  }
+  s.shells[0].contact = ShellDesc::Contact::On;  // self-contact asked for
+  {
+    Solver solver(s);
+    const auto st = solver.stage_names();
+    CHECK(contains(st, "contact"));
+    CHECK(contains(st, "friction"));
+    CHECK(contains(st, "contact_grid"));
+    CHECK(solver.contact(0)->num_sites() == 2 * 8 * 8);
+  }
+  s.shells[0].contact = ShellDesc::Contact::Auto;
+  s.shells.push_back(sheet("b", 0.4, 8, Vec3d(0, 0.1, 0)));
+  s.shells.back().contact = ShellDesc::Contact::Off;
+  {
+    Solver solver(s);  // two shells: auto turns contact on for "a"; "b" stays off the grid
+    CHECK(solver.shell_on_grid(0));
+    CHECK_FALSE(solver.shell_on_grid(1));
+    CHECK(contains(solver.stage_names(), "shell_update"));
+  }
+}
+
+TEST_CASE("two sheets colliding in zero gravity conserve linear momentum", "[contact]") {
+  Scene s = contact_scene(0.025);
+  s.shot.gravity = Vec3d::Zero();
+  s.shells.push_back(sheet("low", 0.3, 12, Vec3d(0, 0, 0)));
+  s.shells.back().velocity = Vec3d(0.1, 1.0, 0);
+  s.shells.push_back(sheet("high", 0.24, 10, Vec3d(0.03, 0.12, -0.02)));
+  s.shells.back().rotate_deg = Vec3d(0, 20, 5);
+  s.shells.back().velocity = Vec3d(0, -1.5, 0.2);
+  Solver solver(s);
+  const Vec3d p0 = total_momentum(solver);
+  double vmin_low = 1e9;
+  std::size_t compressed = 0;
+  for (int f = 2; f <= 8; ++f) {
+    const FrameStats fs = solver.advance_to((f - 1) / s.shot.fps);
+    compressed = std::max(compressed, fs.contact_compressed);
+    double vy = 0, m = 0;
+    for (std::size_t j = 0; j < solver.shells()[0]->size(); ++j) {
+      vy += solver.shells()[0]->mass[j] * solver.shells()[0]->v[j].y();
+      m += solver.shells()[0]->mass[j];
+    }
+    vmin_low = std::min(vmin_low, vy / m);
+    const Vec3d p = total_momentum(solver);
+    INFO("frame " << f << " p0 " << p0.transpose() << " p " << p.transpose());
+    CHECK((p - p0).norm() < 1e-4 * p0.norm() + 1e-7);
+  }
+  // They did collide: contact particles were compressed and the lower sheet was pushed
+  // back (its upward speed dropped well below the initial 1 m/s).
+  CHECK(compressed > 0);
+  CHECK(vmin_low < 0.5);
+}
+
+TEST_CASE("an elastic block hitting a sheet in zero gravity conserves momentum", "[contact]") {
+  Scene s = contact_scene(0.025);
+  s.shot.gravity = Vec3d::Zero();
+  s.shells.push_back(sheet("sheet", 0.4, 16, Vec3d(0, 0, 0)));
+  MaterialDesc jelly;
+  jelly.name = "jelly";
+  jelly.youngs_modulus = 2e4;
+  jelly.density = 500;
+  s.materials.push_back(jelly);
+  SourceDesc src;
+  src.name = "block";
+  src.material = 0;
+  src.shape.kind = ShapeDesc::Kind::Box;
+  src.shape.min = Vec3d(-0.06, 0.04, -0.06);
+  src.shape.max = Vec3d(0.06, 0.14, 0.06);
+  src.velocity = Vec3d(0, -1.0, 0);
+  src.particles_per_cell = 8;
+  s.sources.push_back(src);
+  Solver solver(s);
+  REQUIRE(solver.shell_on_grid(0));
+  const Vec3d p0 = total_momentum(solver);
+  double sheet_vy = -1;
+  for (int f = 2; f <= 8; ++f) {
+    solver.advance_to((f - 1) / s.shot.fps);
+    const Vec3d p = total_momentum(solver);
+    INFO("frame " << f << " p0 " << p0.transpose() << " p " << p.transpose());
+    CHECK((p - p0).norm() < 1e-4 * p0.norm());
+    FrameStats fs;
+    solver.measure(fs);
+    sheet_vy = fs.shell_momentum.y();
+  }
+  CHECK(sheet_vy < -1e-3);  // the block pushed the sheet down
+}
+
+TEST_CASE("a sheet dropped on another never passes through it", "[contact]") {
+  Scene s = contact_scene(0.025);
+  ColliderDesc ground;
+  ground.name = "ground";
+  ground.shape.kind = ShapeDesc::Kind::Plane;
+  ground.shape.point = Vec3d(0, -0.5, 0);
+  ground.shape.normal = Vec3d(0, 1, 0);
+  ground.friction = 0.5;
+  s.colliders.push_back(ground);
+  s.shells.push_back(sheet("bottom", 0.4, 16, Vec3d(0, -0.4, 0)));
+  s.shells.push_back(sheet("top", 0.3, 12, Vec3d(0.02, -0.25, 0.01)));
+  s.shells.back().rotate_deg = Vec3d(0, 30, 0);
+  s.shells.back().velocity = Vec3d(0, -1, 0);
+  Solver solver(s);
+  std::vector<Vec3> top, bot, n;
+  double closest = 1e9;
+  for (int f = 1; f <= 24; ++f) {
+    if (f > 1) solver.advance_to((f - 1) / s.shot.fps);
+    solver.shells()[0]->output_mesh(bot, n);
+    solver.shells()[1]->output_mesh(top, n);
+    // Every top vertex above the bottom sheet's footprint stays above the nearest bottom vertex
+    // (in the horizontal plane).
+    int below = 0;
+    for (const Vec3& t : top) {
+      double best = 1e9;
+      const Vec3* nb = nullptr;
+      for (const Vec3& b : bot) {
+        const double d = std::hypot(t.x() - b.x(), t.z() - b.z());
+        if (d < best) {
+          best = d;
+          nb = &b;
+        }
+      }
+      if (best > 0.02) continue;
+      closest = std::min(closest, static_cast<double>(t.y() - nb->y()));
+      if (t.y() <= nb->y()) ++below;
+    }
+    INFO("frame " << f);
+    CHECK(below == 0);
+  }
+  // The top sheet came to rest on the bottom one (gap below two cells).
+  INFO("closest vertical gap " << closest);
+  CHECK(closest < 2 * s.shot.dx);
+}
+
+TEST_CASE("cloth draped on a sphere penetrates it by less than half a cell", "[contact]") {
+  Scene s = contact_scene(0.025);
+  ColliderDesc ball;
+  ball.name = "ball";
+  ball.shape.kind = ShapeDesc::Kind::Sphere;
+  ball.shape.center = Vec3d(0, -0.3, 0);
+  ball.shape.radius = 0.15;
+  ball.friction = 0.5;
+  s.colliders.push_back(ball);
+  s.shells.push_back(sheet("cloth", 0.5, 20, Vec3d(0, -0.05, 0)));
+  Solver solver(s);
+  REQUIRE(solver.shell_on_grid(0));
+  std::vector<Vec3> pos, n;
+  double min_r = 1e9;
+  for (int f = 2; f <= 24; ++f) {
+    solver.advance_to((f - 1) / s.shot.fps);
+    solver.shells()[0]->output_mesh(pos, n);
+    for (const Vec3& p : pos) min_r = std::min(min_r, (p.cast<double>() - ball.shape.center).norm());
+  }
+  INFO("closest approach to the centre " << min_r << " (radius 0.15, dx 0.025)");
+  CHECK(min_r > 0.15 - 0.5 * s.shot.dx);
+  CHECK(min_r < 0.15 + 2 * s.shot.dx);  // it did land on the ball
+}
+
+namespace {
+
+// Distance travelled down the slope by the centre of mass of shell `i`, sampled at the
+// given times. The slope descends along t = (cos th, -sin th, 0).
+std::vector<double> slide(Solver& solver, std::size_t i, double th, const std::vector<double>& times) {
+  const Vec3d t(std::cos(th), -std::sin(th), 0);
+  std::vector<double> out;
+  for (double tt : times) {
+    if (tt > solver.time()) solver.advance_to(tt);
+    const ShellObject& sh = *solver.shells()[i];
+    Vec3d c = Vec3d::Zero();
+    double m = 0;
+    for (std::size_t j = 0; j < sh.size(); ++j) {
+      c += sh.mass[j] * sh.x[j].cast<double>();
+      m += sh.mass[j];
+    }
+    out.push_back((c / m).dot(t));
+  }
+  return out;
+}
+
+// Least-squares acceleration of s(t) = a0 + a1 t + a/2 t^2.
+double fit_acceleration(const std::vector<double>& t, const std::vector<double>& s) {
+  Eigen::MatrixXd A(t.size(), 3);
+  Eigen::VectorXd b(t.size());
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    A(k, 0) = 1;
+    A(k, 1) = t[k];
+    A(k, 2) = 0.5 * t[k] * t[k];
+    b[k] = s[k];
+  }
+  return A.colPivHouseholderQr().solve(b)[2];
+}
+
+Scene incline_scene(double th_deg, bool on_sheet, double mu, double gap0 = 0.03) {
+  const double th = th_deg * M_PI / 180;
+  const Vec3d n(std::sin(th), std::cos(th), 0);
+  Scene s;
+  s.path = "test";
+  s.shot.dx = 0.02;
+  s.shot.cfl = 0.5;
+  s.shot.fps = 48;
+  s.shot.domain_min = Vec3d(-1, -1, -1);
+  s.shot.domain_max = Vec3d(1, 1, 1);
+  s.shell_materials.push_back(cloth(mu));
+  if (on_sheet) {
+    ShellDesc base = sheet("base", 0.8, 40, Vec3d::Zero());
+    base.rotate_deg = Vec3d(0, 0, -th_deg);
+    PinDesc all;
+    all.has_box = true;
+    all.box_min = Vec3d(-1, -1, -1);
+    all.box_max = Vec3d(1, 1, 1);
+    base.pins.push_back(all);
+    s.shells.push_back(base);
+  } else {
+    ColliderDesc c;
+    c.name = "slope";
+    c.shape.kind = ShapeDesc::Kind::Plane;
+    c.shape.point = Vec3d::Zero();
+    c.shape.normal = n;
+    c.friction = mu;
+    s.colliders.push_back(c);
+  }
+  ShellDesc top = sheet("block", 0.16, 8, gap0 * n + Vec3d(-0.2 * std::cos(th), 0.2 * std::sin(th), 0));
+  top.rotate_deg = Vec3d(0, 0, -th_deg);
+  s.shells.push_back(top);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("a sheet on an inclined collider obeys Coulomb's law (sticks, or slides at g (sin - mu cos))",
+          "[contact]") {
+  const double mu = 0.3;
+  std::vector<double> times;
+  for (int k = 0; k <= 30; ++k) times.push_back(0.1 + 0.01 * k);
+  // 10 degrees: tan = 0.18 < mu, it sticks. 30 degrees: tan = 0.58 > mu, it slides.
+  for (double th_deg : {10.0, 30.0}) {
+    const double th = th_deg * M_PI / 180;
+    Scene s = incline_scene(th_deg, false, mu);
+    Solver solver(s);
+    const auto d = slide(solver, 0, th, times);
+    const double a = fit_acceleration(times, d);
+    const double a_ref = 9.81 * (std::sin(th) - mu * std::cos(th));
+    INFO("incline " << th_deg << " deg: acceleration " << a << " m/s^2, Coulomb " << a_ref
+                    << ", travelled " << d.back() - d.front() << " m");
+    if (a_ref <= 0) {
+      // Frictionless it would travel 1/2 g sin(th) t^2 = 0.22 m from t = 0.1 to 0.4 s.
+      CHECK(std::abs(d.back() - d.front()) < 0.01);
+      CHECK(a < 0.05 * 9.81 * std::sin(th));
+    } else {
+      CHECK(a == Approx(a_ref).epsilon(0.05));
+    }
+  }
+}
+
+TEST_CASE("a sheet on a pinned inclined sheet sticks below the friction angle and slides above it",
+          "[contact][slow]") {
+  // Coulomb between shells. Known limit (issue 4 notes): sliding is slower than
+  // g (sin - c_F cos) because the two sheets share grid nodes across the ~2 dx gap, which
+  // drags them together on top of the contact friction; this test checks the regimes and
+  // prints the measured acceleration.
+  const double mu = 0.3;
+  std::vector<double> times;
+  for (int k = 0; k <= 30; ++k) times.push_back(0.1 + 0.01 * k);
+  for (double th_deg : {10.0, 40.0}) {
+    const double th = th_deg * M_PI / 180;
+    Scene s = incline_scene(th_deg, true, mu, 0.07);
+    Solver solver(s);
+    const auto d = slide(solver, 1, th, times);
+    const double a = fit_acceleration(times, d);
+    const double a_ref = 9.81 * (std::sin(th) - mu * std::cos(th));
+    WARN("sheet on sheet, " << th_deg << " deg: acceleration " << a << " m/s^2, Coulomb "
+                            << std::max(0.0, a_ref) << ", travelled " << d.back() - d.front() << " m");
+    if (a_ref <= 0)
+      CHECK(std::abs(d.back() - d.front()) < 0.01);
+    else
+      CHECK(d.back() - d.front() > 0.05);
+  }
+}
+
+TEST_CASE("sand poured onto a cloth pinned at its corners is held: no sand passes through",
+          "[contact]") {
+  Scene s = contact_scene(0.02);
+  s.shell_materials[0].youngs_modulus = 1e7;  // a canvas hammock
+  ShellDesc cl = sheet("hammock", 0.5, 25, Vec3d(0, 0, 0));
+  for (int idx : {0, 25, 650, 675}) {  // the four corners of the 26 x 26 control points
+    PinDesc p;
+    p.indices = {idx};
+    cl.pins.push_back(p);
+  }
+  s.shells.push_back(cl);
+  MaterialDesc sand;
+  sand.name = "sand";
+  sand.kind = MaterialKind::Sand;
+  sand.youngs_modulus = 3e5;
+  sand.density = 1600;
+  sand.friction_angle_deg = 35;
+  s.materials.push_back(sand);
+  SourceDesc src;
+  src.name = "pile";
+  src.material = 0;
+  src.shape.kind = ShapeDesc::Kind::Box;
+  src.shape.min = Vec3d(-0.05, 0.06, -0.05);
+  src.shape.max = Vec3d(0.05, 0.11, 0.05);
+  src.velocity = Vec3d(0, -1, 0);
+  s.sources.push_back(src);
+  Solver solver(s);
+  REQUIRE(solver.shell_on_grid(0));
+  const std::size_t n0 = solver.particles().size();
+  FrameStats f0;
+  solver.measure(f0);
+  std::vector<Vec3> pos, nrm;
+  int through = 0;
+  double centre_y = 0;
+  for (int f = 2; f <= 18; ++f) {
+    const FrameStats fs = solver.advance_to((f - 1) / s.shot.fps);
+    CHECK(fs.mass == Approx(f0.mass).epsilon(1e-6));
+    CHECK(solver.particles().size() == n0);
+    solver.shells()[0]->output_mesh(pos, nrm);
+    // Each sand particle over the cloth stays above the nearest cloth vertex.
+    for (const Vec3& p : solver.particles().x) {
+      double best = 1e9;
+      Real y = 0;
+      for (const Vec3& c : pos) {
+        const double d = std::hypot(p.x() - c.x(), p.z() - c.z());
+        if (d < best) {
+          best = d;
+          y = c.y();
+        }
+      }
+      if (best < 0.01 && p.y() < y) ++through;
+    }
+    centre_y = pos[pos.size() / 2].y();
+  }
+  INFO("sand particles found below the cloth: " << through << "; cloth centre at y = " << centre_y);
+  CHECK(through == 0);
+  CHECK(centre_y < -0.005);  // it sags under the load (a quarter cell for this stiff canvas)
+  // The sand came to rest on the cloth: no particle fell far below it.
+  double ymin = 1e9;
+  for (const Vec3& p : solver.particles().x) ymin = std::min(ymin, static_cast<double>(p.y()));
+  CHECK(ymin > centre_y - 0.05);
+}
