@@ -1,5 +1,6 @@
 // Small helpers shared by the benchmark programs.
 #pragma once
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <string>
@@ -14,6 +15,28 @@ inline std::vector<int> parse_int_list(const std::string& text) {
   std::string t;
   while (std::getline(ss, t, ',')) out.push_back(std::atoi(t.c_str()));
   return out;
+}
+
+/// Options of the sheet benchmarks: --vertices N --steps S --threads 1,2.
+struct SheetArgs {
+  double vertices = 100000;
+  int steps = 20;
+  std::vector<int> threads = {1, 2};
+};
+
+/// Parses SheetArgs; prints the offending option and returns false on an unknown one.
+inline bool parse_sheet_args(int argc, char** argv, SheetArgs& a) {
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string k = argv[i];
+    if (k == "--vertices") a.vertices = std::atof(argv[i + 1]);
+    else if (k == "--steps") a.steps = std::atoi(argv[i + 1]);
+    else if (k == "--threads") a.threads = parse_int_list(argv[i + 1]);
+    else {
+      std::fprintf(stderr, "unknown option %s\n", k.c_str());
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace shellmpm_bench

@@ -20,19 +20,11 @@
 using namespace shellmpm;
 
 int main(int argc, char** argv) {
-  double vertices = 100000;
-  int steps = 20;
-  std::vector<int> threads = {1, 2};
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string k = argv[i];
-    if (k == "--vertices") vertices = std::atof(argv[i + 1]);
-    else if (k == "--steps") steps = std::atoi(argv[i + 1]);
-    else if (k == "--threads") threads = shellmpm_bench::parse_int_list(argv[i + 1]);
-    else {
-      std::fprintf(stderr, "unknown option %s\n", k.c_str());
-      return 2;
-    }
-  }
+  shellmpm_bench::SheetArgs args;
+  if (!shellmpm_bench::parse_sheet_args(argc, argv, args)) return 2;
+  const double vertices = args.vertices;
+  const int steps = args.steps;
+  const std::vector<int>& threads = args.threads;
   const int n = static_cast<int>(std::round(std::sqrt(vertices))) - 1;
   const double size = 2.0, h = size / n;
   Scene s;

@@ -4,20 +4,30 @@
 #include <cmath>
 
 #include "sim/solver/solver.h"
+#include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;
 
 namespace {
 
 ShellMaterialDesc cloth(double friction = 0.3) {
-  ShellMaterialDesc m;
-  m.name = "cloth";
-  m.youngs_modulus = 2e5;
-  m.poisson_ratio = 0.3;
-  m.density = 300;
-  m.thickness = 1e-3;
+  ShellMaterialDesc m = test::cloth_material();
   m.friction = friction;
   return m;
+}
+
+// A box of bulk material (a new material entry) with an initial velocity.
+void add_box_source(Scene& s, const MaterialDesc& mat, const Vec3d& lo, const Vec3d& hi,
+                    const Vec3d& velocity) {
+  s.materials.push_back(mat);
+  SourceDesc src;
+  src.name = mat.name;
+  src.material = static_cast<int>(s.materials.size()) - 1;
+  src.shape.kind = ShapeDesc::Kind::Box;
+  src.shape.min = lo;
+  src.shape.max = hi;
+  src.velocity = velocity;
+  s.sources.push_back(src);
 }
 
 ShellDesc sheet(const std::string& name, double size, int res, const Vec3d& at) {
@@ -123,16 +133,7 @@ TEST_CASE("an elastic block hitting a sheet in zero gravity conserves momentum",
   jelly.name = "jelly";
   jelly.youngs_modulus = 2e4;
   jelly.density = 500;
-  s.materials.push_back(jelly);
-  SourceDesc src;
-  src.name = "block";
-  src.material = 0;
-  src.shape.kind = ShapeDesc::Kind::Box;
-  src.shape.min = Vec3d(-0.06, 0.04, -0.06);
-  src.shape.max = Vec3d(0.06, 0.14, 0.06);
-  src.velocity = Vec3d(0, -1.0, 0);
-  src.particles_per_cell = 8;
-  s.sources.push_back(src);
+  add_box_source(s, jelly, Vec3d(-0.06, 0.04, -0.06), Vec3d(0.06, 0.14, 0.06), Vec3d(0, -1, 0));
   Solver solver(s);
   REQUIRE(solver.shell_on_grid(0));
   const Vec3d p0 = total_momentum(solver);
@@ -356,15 +357,7 @@ TEST_CASE("sand poured onto a cloth pinned at its corners is held: no sand passe
   sand.youngs_modulus = 3e5;
   sand.density = 1600;
   sand.friction_angle_deg = 35;
-  s.materials.push_back(sand);
-  SourceDesc src;
-  src.name = "pile";
-  src.material = 0;
-  src.shape.kind = ShapeDesc::Kind::Box;
-  src.shape.min = Vec3d(-0.05, 0.06, -0.05);
-  src.shape.max = Vec3d(0.05, 0.11, 0.05);
-  src.velocity = Vec3d(0, -1, 0);
-  s.sources.push_back(src);
+  add_box_source(s, sand, Vec3d(-0.05, 0.06, -0.05), Vec3d(0.05, 0.11, 0.05), Vec3d(0, -1, 0));
   Solver solver(s);
   REQUIRE(solver.shell_on_grid(0));
   const std::size_t n0 = solver.particles().size();

@@ -6,6 +6,7 @@
 #include "sim/shell/mesh_check.h"
 #include "sim/shell/procedural_mesh.h"
 #include "sim/solver/solver.h"
+#include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;
 
@@ -32,12 +33,7 @@ Scene shell_scene(const ShellMaterialDesc& mat, const ShellDesc& sh) {
 }
 
 ShellMaterialDesc cloth() {
-  ShellMaterialDesc m;
-  m.name = "cloth";
-  m.youngs_modulus = 2e5;
-  m.poisson_ratio = 0.3;
-  m.density = 300;
-  m.thickness = 1e-3;
+  ShellMaterialDesc m = test::cloth_material();
   return m;
 }
 

@@ -5,6 +5,7 @@
 
 #include "sim/shell/static_solver.h"
 #include "sim/solver/solver.h"
+#include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;
 
@@ -50,12 +51,7 @@ Scene drape_scene(PrerollSettings::Method method) {
   s.shot.dt_max = 1e-2;
   s.shot.domain_min = Vec3d(-5, -5, -5);
   s.shot.domain_max = Vec3d(5, 5, 5);
-  ShellMaterialDesc m;
-  m.name = "cloth";
-  m.youngs_modulus = 2e5;
-  m.poisson_ratio = 0.3;
-  m.density = 300;
-  m.thickness = 1e-3;
+  ShellMaterialDesc m = test::cloth_material();
   s.shell_materials.push_back(m);
   ShellDesc sh;
   sh.name = "drape";
