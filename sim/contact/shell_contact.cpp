@@ -117,6 +117,22 @@ void ShellContact::update_positions(const Vec3* ctrl, bool serial) {
       serial);
 }
 
+void ShellContact::reset(const Vec3* ctrl, bool serial) {
+  update_positions(ctrl, serial);
+  parallel_for(
+      num_sites(), kGrain,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t p = b; p < e; ++p) {
+          Vec3 a1, a2;
+          tangents(ctrl, p, a1, a2);
+          a3e[p] = a1.cross(a2).normalized();
+          state[p] = static_cast<std::uint8_t>(ContactState::Separated);
+        }
+      },
+      serial);
+  for (Mat3& c : C) c.setZero();
+}
+
 double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
   const double e = chunked_sum<double>(num_sites(), serial, [&](std::size_t p) {
     Vec3 a1, a2;

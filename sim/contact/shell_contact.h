@@ -43,6 +43,9 @@ class ShellContact {
   double energy(const Vec3* ctrl, bool serial) const;
   /// Coulomb return mapping with the current control points and a3E; rewrites a3E.
   ContactStepStats return_map(const Vec3* ctrl, bool serial);
+  /// Makes the current shape the contact rest state: a3E = the unit normal, C = 0, and
+  /// the positions updated (after a pre-roll moved the control points).
+  void reset(const Vec3* ctrl, bool serial);
   /// Tangents a_1, a_2 of site p.
   void tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2) const;
 

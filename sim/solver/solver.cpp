@@ -481,6 +481,15 @@ void Solver::measure(FrameStats& s) const {
 
 int Solver::preroll(const PrerollSettings& p) {
   if (shells_.empty()) return 0;
+  const int steps = settle_shells(p);
+  // The settled shape is the contact particles' new reference: unit normal columns, no
+  // APIC velocity field (else the sag would read as compression).
+  for (std::size_t i = 0; i < shells_.size(); ++i)
+    if (contacts_[i]) contacts_[i]->reset(shells_[i]->x.data(), opt_.serial);
+  return steps;
+}
+
+int Solver::settle_shells(const PrerollSettings& p) {
   // Reference force scale: the largest weight of a control point (or 1 N without gravity).
   double fref = 0;
   for (const auto& sh : shells_)

@@ -94,6 +94,7 @@ class Solver {
   void emit();
   void clamp_to_domain();
   void setup_contact();
+  int settle_shells(const PrerollSettings& p);
   void apply_walls();
   void add_grid_stages();
   TransferParams transfer_params();
