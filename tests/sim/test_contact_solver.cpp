@@ -420,3 +420,4 @@ TEST_CASE("pre-roll makes the settled shape the contact rest state", "[contact]"
   CHECK(std::isfinite(f1.shell_kinetic_energy));
   CHECK(f1.shell_kinetic_energy < 1e-3);  // it stays (nearly) at rest
 }
+
