@@ -1,0 +1,42 @@
+// The command line on contact scenes: `check` reports contact parameters and warns when
+// the control mesh spacing is far from dx; runs are thread-count independent and resumable.
+#include <catch2/catch.hpp>
+
+#include "tests/app/cli_harness.h"
+#include "tests/support/temp_dir.h"
+
+using namespace shellmpm_test;
+
+TEST_CASE("CLI: check reports contact and warns when the mesh spacing is far from dx", "[cli]") {
+  const std::string scene = std::string(SHELLMPM_SOURCE_DIR) + "/scenes/cloth_drape.yaml";
+  const CmdResult ok = run_shellmpm("check " + scene);
+  INFO(ok.output);
+  CHECK(ok.code == 0);
+  CHECK(ok.output.find("contact: 3200 contact particles") != std::string::npos);
+  CHECK(ok.output.find("warning") == std::string::npos);
+  const CmdResult fine = run_shellmpm("check " + scene + " --set shot.dx=0.01");
+  INFO(fine.output);
+  CHECK(fine.code == 0);
+  CHECK(fine.output.find("warning: shell cloth: its mesh spacing") != std::string::npos);
+  CHECK(fine.output.find("much coarser") != std::string::npos);
+}
+
+TEST_CASE("CLI: a contact scene gives the same meshes on 1 and 2 threads and after --resume",
+          "[cli]") {
+  TempDir d("contact");
+  const std::string scene = std::string(SHELLMPM_SOURCE_DIR) + "/scenes/cloth_drape.yaml";
+  const std::string common = " --frames 1-6 --set output.checkpoint_every=3 -q -o ";
+  // The cloth reaches the ball at about t = 0.17 s (frame 5): frame 6 is in contact.
+  REQUIRE(run_shellmpm("run " + scene + common + d.file("a") + " --threads 1").code == 0);
+  REQUIRE(run_shellmpm("run " + scene + common + d.file("b") + " --threads 2").code == 0);
+  REQUIRE(run_shellmpm("run " + scene + " --frames 1-3 --set output.checkpoint_every=3 -q -o " +
+                       d.file("c"))
+              .code == 0);
+  REQUIRE(run_shellmpm("run " + scene + common + d.file("c") + " --resume").code == 0);
+  const std::string a = read_text(d.file("a/cloth.0006.ply"));
+  CHECK(a.size() > 1000);
+  CHECK(a == read_text(d.file("b/cloth.0006.ply")));
+  CHECK(a == read_text(d.file("c/cloth.0006.ply")));
+  CHECK(a != read_text(d.file("a/cloth.0005.ply")));  // the comparison can fail
+  CHECK(read_text(d.file("a/stats.json")).find("\"contact_compressed\"") != std::string::npos);
+}
