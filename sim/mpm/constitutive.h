@@ -115,9 +115,28 @@ struct ConstitutiveModelT {
   void project(Mat3T& F, T& plastic) const;
   /// project(F, plastic) followed by kirchhoff(F, plastic), sharing one SVD.
   Mat3T project_and_kirchhoff(Mat3T& F, T& plastic) const;
-  /// Dilatational wave speed sqrt((lambda + 2 mu) / density) [m/s] with the current
-  /// (snow: hardened) moduli; density in kg/m^3.
+  /// Dilatational wave speed at rest, sqrt((lambda + 2 mu) / density) [m/s], with the
+  /// current (snow: hardened) moduli; density in kg/m^3. Equals wave_speed(I, ...).
   T wave_speed(T density, T plastic) const;
+  /// Upper bound on rho0 c^2 [Pa], c the spatial (Eulerian) longitudinal wave speed along
+  /// any principal direction of the deformed state F, rho0 the rest density. In principal
+  /// direction i, rho0 c_i^2 = d tau_i / d ln sigma_i - tau_i = sigma_i^2 d^2 psi / d
+  /// sigma_i^2 (tau_i the principal Kirchhoff stress). Per model (h: snow hardening):
+  ///   neo-Hookean:     mu (sigma_max^2 + 1) + lambda (1 - log J_c)
+  ///   fixed corotated: h (2 mu sigma_max^2 + lambda J^2)   (snow alike)
+  ///   sand (Hencky):   lambda + 2 mu - 2 mu log sigma_min - lambda log |J|   (>= 0)
+  /// with sigma_max^2 and sigma_min^2 replaced by the cheap bounds of
+  /// detail::squared_stretch_bounds (no SVD) and the Hencky clamp kHenckyMinSigma applied
+  /// to the sand logarithms. Exactly lambda + 2 mu (times h) at F = I (and any rotation).
+  /// Derived for longitudinal waves along the principal axes; on sampled states (J in
+  /// [0.2, 3]) it also bounded the acoustic tensor over all directions and polarizations
+  /// (tests/mpm/test_wave_speed.cpp checks the principal-axis bound only).
+  T wave_modulus(const Mat3T& F, T plastic) const;
+  /// sqrt(wave_modulus(F, plastic) / density) [m/s]: an upper bound on the spatial
+  /// longitudinal wave speed of deformed material; density is the rest density [kg/m^3].
+  T wave_speed(const Mat3T& F, T density, T plastic) const {
+    return std::sqrt(wave_modulus(F, plastic) / density);
+  }
 
   /// Batch forms over n particles (arrays of n entries). Same results as the per-particle
   /// calls up to rounding, but the SVDs run svd3_batch_width<T>() particles at a time in
@@ -181,6 +200,31 @@ inline Eigen::Matrix<T, 3, 1> hencky_strain(const Eigen::Matrix<T, 3, 1>& sigma,
   Eigen::Matrix<T, 3, 1> e;
   for (int i = 0; i < 3; ++i) e(i) = std::log(std::max(std::abs(sigma(i)), s_min));
   return e;
+}
+
+/// Bounds on the extreme eigenvalues of C = F^T F (the squared singular values of F)
+/// without an eigen-solve. With m = tr(C)/3 and D = |C|_F^2 - tr(C)^2/3 (the sum of the
+/// squared deviations of the eigenvalues from m), Samuelson's inequality puts every
+/// eigenvalue within m -+ sqrt(2 D / 3); the smallest is also >= det(C) / I_2(C), I_2 the
+/// second invariant (which bounds the product of the two largest). Exact (1, 1) for a
+/// rotation; the upper bound is exact for uniaxial stretch. Returns sigma_max^2 >= its
+/// bound; *lo (optional) gets a lower bound on sigma_min^2 (possibly 0).
+template <class T>
+inline T squared_stretch_bounds(const Eigen::Matrix<T, 3, 3>& F, T* lo = nullptr) {
+  const T c00 = F.col(0).squaredNorm(), c11 = F.col(1).squaredNorm(),
+          c22 = F.col(2).squaredNorm();
+  const T c01 = F.col(0).dot(F.col(1)), c02 = F.col(0).dot(F.col(2)),
+          c12 = F.col(1).dot(F.col(2));
+  const T tr = c00 + c11 + c22;
+  const T c2 = c00 * c00 + c11 * c11 + c22 * c22 + T(2) * (c01 * c01 + c02 * c02 + c12 * c12);
+  const T m = tr / T(3);
+  const T r = std::sqrt(std::max(c2 - tr * m, T(0)) * (T(2) / T(3)));
+  if (lo) {
+    const T i2 = (tr * tr - c2) / T(2);
+    const T J = F.determinant();
+    *lo = std::max(m - r, i2 > T(0) ? J * J / i2 : T(0));
+  }
+  return m + r;
 }
 
 }  // namespace detail
@@ -365,6 +409,29 @@ inline typename ConstitutiveModelT<T>::Mat3T ConstitutiveModelT<T>::project_and_
 template <class T>
 inline T ConstitutiveModelT<T>::wave_speed(T density, T plastic) const {
   return std::sqrt((lambda + T(2) * mu) * hardening(plastic) / density);
+}
+
+template <class T>
+inline T ConstitutiveModelT<T>::wave_modulus(const Mat3T& F, T plastic) const {
+  if (kind == MaterialKind::Sand) {
+    // tau_i = 2 mu e_i + lambda tr(e) gives d tau_i / d e_i - tau_i <= lambda + 2 mu - tau_i
+    // (equal where sigma_i is not clamped); e_i >= log sigma_min, tr(e) >= log |J|.
+    T s2_lo;
+    detail::squared_stretch_bounds(F, &s2_lo);
+    const T s_min = kHenckyMinSigma;
+    const T e_lo = T(0.5) * std::log(std::max(s2_lo, s_min * s_min));
+    const T tr_lo = std::log(std::max(std::abs(F.determinant()), s_min * s_min * s_min));
+    return std::max(lambda + T(2) * mu - T(2) * mu * e_lo - lambda * tr_lo, T(0));
+  }
+  const T s2_max = detail::squared_stretch_bounds(F);
+  const T J = F.determinant();
+  if (kind == MaterialKind::Elastic && elastic == ElasticModel::NeoHookean) {
+    // tau_i = mu (sigma_i^2 - 1) + lambda log J_c.
+    const T lj = std::log(std::max(J, kNeoHookeanMinJ));
+    return mu * (s2_max + T(1)) + lambda * (T(1) - lj);
+  }
+  // Fixed corotated, snow: tau_i = 2 mu h (sigma_i - 1) sigma_i + lambda h (J - 1) J.
+  return hardening(plastic) * (T(2) * mu * s2_max + lambda * J * J);
 }
 
 template <class T>

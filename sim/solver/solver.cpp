@@ -347,16 +347,19 @@ double Solver::stable_dt() const {
     parallel_for(
         n, kParticleGrain,
         [&](std::size_t b, std::size_t e) {
-          Real v2 = 0, c = 0;
+          // Squared wave speeds, from the deformed state F (a material stiffens or softens
+          // as it is squeezed); one square root per chunk.
+          Real v2 = 0, c2 = 0;
           for (std::size_t p = b; p < e; ++p) {
             v2 = std::max(v2, particles_.v[p].squaredNorm());
             const auto mat = particles_.material[p];
-            c = std::max(c, models_[mat].wave_speed(
-                                densities_[mat],
-                                particles_.has_plastic() ? particles_.plastic[p] : Real(1)));
+            c2 = std::max(c2, models_[mat].wave_modulus(
+                                  particles_.F[p],
+                                  particles_.has_plastic() ? particles_.plastic[p] : Real(1)) /
+                                  densities_[mat]);
           }
           vm[b / kParticleGrain] = std::sqrt(static_cast<double>(v2));
-          cm[b / kParticleGrain] = c;
+          cm[b / kParticleGrain] = std::sqrt(c2);
         },
         opt_.serial);
     vmax = *std::max_element(vm.begin(), vm.end());
