@@ -143,6 +143,7 @@ std::vector<KeySpec> build_schema() {
       Spec("shot.dx", T::Number).required().unit("m").gt(0).rule("at most 2^20 cells per axis"),
       Spec("shot.threads", T::Int).def("0").ge(0),
       Spec("shot.transfer", T::Enum).def("apic").choices({"apic", "mls"}),
+      Spec("shot.shell_velocities", T::Enum).def("per_shell").choices({"per_shell", "shared"}),
       Spec("shot.units", T::String).def("m").nonempty(),
       // materials
       Spec("materials[].name", T::String).required().nonempty().rule("unique"),
@@ -1366,6 +1367,7 @@ void read_shot(const DocNode& node, ShotSettings& shot) {
   }
   shot.threads = r.int32("threads");
   shot.transfer = r.choice("transfer");
+  shot.shared_shell_velocity = r.choice("shell_velocities") == "shared";
   shot.units = r.string("units");
   r.finish();
 }

@@ -90,23 +90,14 @@ void SparseGrid::gather(bool with_mass, bool serial) {
       [&](std::size_t gb, std::size_t ge) {
         for (std::size_t g = gb; g < ge; ++g) {
           auto& nodes = gblock_nodes[g];
-          for (int o = 0; o < 8; ++o) {
-            const int src = gblock_src[g][o];
-            if (src < 0) continue;
-            const auto& buf = pblock_buf[src];
-            const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
-            const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
-            for (int i = 0; i < ix1; ++i)
-              for (int j = 0; j < iy1; ++j)
-                for (int k = 0; k < iz1; ++k) {
-                  const GridNode& s = buf[pad_node(i + ox, j + oy, k + oz)];
-                  GridNode& d = nodes[block_node(i, j, k)];
-                  if (with_mass) d.m += s.m;
-                  d.v[0] += s.v[0];
-                  d.v[1] += s.v[1];
-                  d.v[2] += s.v[2];
-                }
-          }
+          for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
+            const GridNode& from = pblock_buf[src][sn];
+            GridNode& d = nodes[dn];
+            if (with_mass) d.m += from.m;
+            d.v[0] += from.v[0];
+            d.v[1] += from.v[1];
+            d.v[2] += from.v[2];
+          });
         }
       },
       serial);

@@ -84,6 +84,25 @@ class SparseGrid {
         }
   }
 
+  /// Index of the grid block with packed key `key`, or -1.
+  int find_grid_block(std::uint64_t key) const { return ghash_.find(key); }
+
+  /// For grid block g, calls f(block_node_index, particle_block, pad_node_index) for each
+  /// padded-buffer node that overlaps it, in the fixed order the gathers use.
+  template <class F>
+  void for_each_buffer_node(std::size_t g, F&& f) const {
+    for (int o = 0; o < 8; ++o) {
+      const int src = gblock_src[g][o];
+      if (src < 0) continue;
+      const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
+      const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
+      for (int i = 0; i < ix1; ++i)
+        for (int j = 0; j < iy1; ++j)
+          for (int k = 0; k < iz1; ++k)
+            f(block_node(i, j, k), static_cast<std::size_t>(src), pad_node(i + ox, j + oy, k + oz));
+    }
+  }
+
   /// Sums every particle block's buffer into the grid blocks (fixed order).
   void gather_buffers_to_grid(bool serial = false) { gather(true, serial); }
   /// Adds every particle block buffer's v into the grid nodes' v (fixed order); the

@@ -26,6 +26,9 @@ struct ShotSettings {
   double dx = 0.02;               ///< grid spacing [m]
   int threads = 0;                ///< 0 = all cores
   std::string transfer = "apic";  ///< "apic" (quadratic B-spline APIC) or "mls" (MLS-MPM)
+  /// True: shells that share grid nodes share one velocity there (no-slip between them,
+  /// as in the paper); false: each keeps its own (ShellFields), friction from contact only.
+  bool shared_shell_velocity = false;
   std::string units = "m";        ///< informational, written to VDB metadata
 };
 

@@ -104,6 +104,7 @@ void Solver::setup_contact() {
     grid_shells_.push_back(std::move(g));
   }
   shell_table_.build(grid_shells_);
+  shell_fields_.setup(grid_, scene_.shot.shared_shell_velocity ? 0 : grid_shells_.size());
 }
 
 TransferParams Solver::transfer_params() {
@@ -185,6 +186,7 @@ void Solver::add_grid_stages() {
                            shell_p2g_block(grid_, shell_table_, grid_shells_, dt, b, buf);
                          };
                        particles_to_grid(particles_, grid_, tp);
+                       if (shell_fields_.active()) shell_fields_.p2g(grid_shells_, dt, opt_.serial);
                      }});
   stages_.push_back({"grid", [this] { grid_update(); }});
   if (on_grid)
@@ -202,6 +204,10 @@ void Solver::add_grid_stages() {
                            shell_g2p_block(grid_, shell_table_, grid_shells_, dt, b, buf);
                          };
                        grid_to_particles(particles_, grid_, tp);
+                       if (shell_fields_.active())
+                         shell_fields_.correct(
+                             grid_, grid_shells_, dt,
+                             [this](const Vec3i& n) { return single_velocity_node(n); }, opt_.serial);
                        clamp_to_domain();
                      }});
   if (on_grid)
@@ -245,6 +251,19 @@ void Solver::grid_update() {
           });
       },
       opt_.serial);
+}
+
+bool Solver::single_velocity_node(const Vec3i& n) const {
+  for (int a = 0; a < 3; ++a)
+    if (n[a] < kWallCells || n[a] > domain_cells_[a] - kWallCells) return true;
+  Aabb at;
+  at.lo = at.hi = grid_.node_position(n);
+  for (const Collider& c : colliders_) {
+    if (!c.bounds().overlaps(at)) continue;
+    Vec3 v = Vec3::Zero();
+    if (c.apply(at.lo, v)) return true;
+  }
+  return false;
 }
 
 void Solver::apply_walls() {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim/collider/collider.h"
+#include "sim/contact/shell_fields.h"
 #include "sim/contact/shell_transfer.h"
 #include "sim/mpm/constitutive.h"
 #include "sim/mpm/particles.h"
@@ -96,6 +97,8 @@ class Solver {
   void setup_contact();
   int settle_shells(const PrerollSettings& p);
   void apply_walls();
+  /// Nodes where shells keep one shared velocity: walls and colliders.
+  bool single_velocity_node(const Vec3i& n) const;
   void add_grid_stages();
   TransferParams transfer_params();
 
@@ -112,6 +115,7 @@ class Solver {
   std::vector<std::vector<Vec3>> shell_forces_;
   std::vector<std::unique_ptr<ShellContact>> contacts_;  ///< per shell; null: no contact
   std::vector<GridShell> grid_shells_;
+  ShellFields shell_fields_;  ///< per-shell velocities on shared nodes (two or more shells)
   ShellPointTable shell_table_;
   std::vector<Vec3> shell_points_;  ///< binned positions of the grid shells' points
   ContactStepStats contact_step_;   ///< the last step's return mapping
