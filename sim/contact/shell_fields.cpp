@@ -6,122 +6,210 @@
 #include "sim/mpm/bspline.h"
 
 namespace shellmpm {
+namespace {
+constexpr Real kBulkMin = Real(1e-3);    ///< bulk share of a node's mass that gets a field
+constexpr Real kShellOnly = Real(1e-4);  ///< below this bulk share the node is shells only
+}  // namespace
 
-void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells) {
-  grids_.clear();
-  if (num_shells < 2) return;
-  grids_.resize(num_shells);
-  for (Field& f : grids_) f.grid.setup(grid.dx(), grid.origin());
+// Bardenhagen's contact between the bulk field (mass mk, velocity vk) and a shell's
+// field f (velocity vs) at one node; the node is on the side of the shell f.n points to.
+void ShellFields::bulk_contact(const Node& f, Real friction, Real mk, Vec3& vk, Vec3& vs) {
+  const Vec3 nsum(f.n[0], f.n[1], f.n[2]);
+  const Real nl = nsum.norm();
+  if (!(nl > 0)) return;
+  const Vec3 nrm = nsum / nl;
+  const Vec3 u = vk - vs;  // bulk relative to the shell
+  const Real un = u.dot(nrm);
+  if (un >= 0) return;  // separating
+  Vec3 ut = u - un * nrm;
+  const Real tl = ut.norm();
+  const Real drop = -friction * un;
+  ut = tl <= drop ? Vec3::Zero() : Vec3(ut * (1 - drop / tl));
+  const Vec3 du = ut - u;  // the new relative velocity is ut
+  const Real mt = mk + f.m;
+  vk += (f.m / mt) * du;
+  vs -= (mk / mt) * du;
 }
 
-void ShellFields::p2g(const std::vector<GridShell>& shells, Real dt, bool serial) {
-  for (std::size_t s = 0; s < grids_.size(); ++s) {
-    Field& F = grids_[s];
-    const GridShell& gs = shells[s];
-    const ShellObject& sh = *gs.shell;
-    F.x0 = sh.x;
-    F.grid.bin(sh.x, serial);
-    const std::size_t nb = F.grid.num_particle_blocks(), ng = F.grid.num_grid_blocks();
-    F.buf.resize(nb);
-    F.nodes.resize(ng);
-    F.r.resize(ng);
-    const Real dx = static_cast<Real>(F.grid.dx());
-    parallel_for(
-        nb, 1,
-        [&](std::size_t bb, std::size_t be) {
-          for (std::size_t b = bb; b < be; ++b) {
-            auto& buf = F.buf[b];
-            std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
-            const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
-            for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
-              const std::uint32_t j = F.grid.order[q];
-              const Real m = sh.mass[j];
-              const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
-              const Mat3 A = (m * dx) * gs.contact->C[j];
-              const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-              const Vec3 base = m * sh.v[j] + dt * gs.force[j] - A * fx;
-              const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-              for (int i = 0; i < 3; ++i)
-                for (int jj = 0; jj < 3; ++jj)
-                  for (int k = 0; k < 3; ++k) {
-                    const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];
-                    const Vec3 mom = w * (base + A * Vec3(Real(i), Real(jj), Real(k)));
-                    Node& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
-                    nd.m += w * m;
-                    for (int a = 0; a < 3; ++a) nd.p[a] += mom[a];
-                  }
-            }
-          }
-        },
-        serial);
-    parallel_for(
-        ng, 4,
-        [&](std::size_t gb, std::size_t ge) {
-          for (std::size_t g = gb; g < ge; ++g) {
-            auto& nodes = F.nodes[g];
-            std::memset(static_cast<void*>(nodes.data()), 0, sizeof(nodes));
-            F.r[g].fill(Vec3::Zero());
-            F.grid.for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
-              const Node& from = F.buf[src][sn];
-              Node& d = nodes[dn];
-              d.m += from.m;
-              for (int a = 0; a < 3; ++a) d.p[a] += from.p[a];
-            });
-            for (Node& d : nodes)
-              if (d.m > 0)
-                for (Real& p : d.p) p /= d.m;
-          }
-        },
-        serial);
+void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bulk) {
+  fields_.clear();
+  active_ = num_shells >= 2 || (num_shells >= 1 && bulk);
+  if (!active_) return;
+  fields_.resize(num_shells);
+  for (Field& f : fields_) f.grid.setup(grid.dx(), grid.origin());
+}
+
+void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial) {
+  const ShellObject& sh = *gs.shell;
+  F.x0 = sh.x;
+  // Control-point normals: area-weighted normals of the control mesh's triangles.
+  F.normal.assign(sh.size(), Vec3::Zero());
+  for (const Eigen::Vector3i& t : sh.triangles()) {
+    const Vec3 a = (sh.x[t[1]] - sh.x[t[0]]).cross(sh.x[t[2]] - sh.x[t[0]]);
+    for (int k = 0; k < 3; ++k) F.normal[t[k]] += a;
   }
+  for (Vec3& n : F.normal) {
+    const Real l = n.norm();
+    n = l > 0 ? Vec3(n / l) : Vec3::Zero();
+  }
+  F.grid.bin(sh.x, serial);
+  const std::size_t nb = F.grid.num_particle_blocks(), ng = F.grid.num_grid_blocks();
+  F.buf.resize(nb);
+  F.nodes.resize(ng);
+  F.r.resize(ng);
+  const Real dx = static_cast<Real>(F.grid.dx());
+  parallel_for(
+      nb, 1,
+      [&](std::size_t bb, std::size_t be) {
+        for (std::size_t b = bb; b < be; ++b) {
+          auto& buf = F.buf[b];
+          std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
+          const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
+          for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
+            const std::uint32_t j = F.grid.order[q];
+            const Real m = sh.mass[j];
+            const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
+            const Mat3 A = (m * dx) * gs.contact->C[j];
+            const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
+            const Vec3 base = m * sh.v[j] + dt * gs.force[j] - A * fx;
+          const Vec3& nj = F.normal[j];
+            const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+            for (int i = 0; i < 3; ++i)
+              for (int jj = 0; jj < 3; ++jj)
+                for (int k = 0; k < 3; ++k) {
+                  const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];
+                  const Vec3 mom = w * (base + A * Vec3(Real(i), Real(jj), Real(k)));
+                  // The normal turned to the node's side of the shell.
+                  const Real side = nj.dot(Vec3(Real(i), Real(jj), Real(k)) - fx);
+                  const Real wn = side > 0 ? w * m : side < 0 ? -w * m : Real(0);
+                  Node& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
+                  nd.m += w * m;
+                  for (int a = 0; a < 3; ++a) {
+                    nd.p[a] += mom[a];
+                    nd.n[a] += wn * nj[a];
+                  }
+                }
+          }
+        }
+      },
+      serial);
+  parallel_for(
+      ng, 4,
+      [&](std::size_t gb, std::size_t ge) {
+        for (std::size_t g = gb; g < ge; ++g) {
+          auto& nodes = F.nodes[g];
+          std::memset(static_cast<void*>(nodes.data()), 0, sizeof(nodes));
+          F.r[g].fill(Vec3::Zero());
+          F.grid.for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
+            const Node& from = F.buf[src][sn];
+            Node& d = nodes[dn];
+            d.m += from.m;
+            for (int a = 0; a < 3; ++a) {
+              d.p[a] += from.p[a];
+              d.n[a] += from.n[a];
+            }
+          });
+          for (Node& d : nodes)
+            if (d.m > 0)
+              for (Real& p : d.p) p /= d.m;
+        }
+      },
+      serial);
 }
 
-void ShellFields::correct(const SparseGrid& combined, std::vector<GridShell>& shells,
-                                 Real dt, const SkipFn& skip, bool serial) {
-  const std::size_t K = grids_.size();
-  // Relative velocities at nodes shared by shells only.
+void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& shells, Real dt,
+                      bool serial) {
+  const std::size_t K = fields_.size();
+  friction_.resize(K);
+  for (std::size_t s = 0; s < K; ++s) {
+    shell_p2g(fields_[s], shells[s], dt, serial);
+    friction_[s] = shells[s].contact->params().friction;
+  }
+  const std::size_t ng = combined.num_grid_blocks();
+  fblock_.assign(ng * K, -1);
+  r_bulk_.resize(ng);
+  shared_.assign(ng, 0);
   parallel_for(
-      combined.num_grid_blocks(), 4,
+      ng, 4,
       [&](std::size_t gb, std::size_t ge) {
-        std::vector<int> fb(K);
         for (std::size_t g = gb; g < ge; ++g) {
-          const std::uint64_t key = combined.gblock_key[g];
+          int* fb = fblock_.data() + g * K;
           int present = 0;
           for (std::size_t s = 0; s < K; ++s) {
-            fb[s] = grids_[s].grid.find_grid_block(key);
+            fb[s] = fields_[s].grid.find_grid_block(combined.gblock_key[g]);
             if (fb[s] >= 0) ++present;
           }
-          if (present < 2) continue;
-          const Vec3i c = unpack_block(key) * kBlockSize;
+          if (present == 0) continue;
+          r_bulk_[g].fill(Vec3::Zero());
           for (int n = 0; n < kBlockNodes; ++n) {
-            const Real m = combined.gblock_nodes[g][n].m;
-            if (m <= 0) continue;
+            const GridNode& cn = combined.gblock_nodes[g][n];
+            if (cn.m <= 0) continue;
             Real ms = 0;
             Vec3 ps = Vec3::Zero();
             int cnt = 0;
             for (std::size_t s = 0; s < K; ++s) {
               if (fb[s] < 0) continue;
-              const Node& f = grids_[s].nodes[fb[s]][n];
+              const Node& f = fields_[s].nodes[fb[s]][n];
               if (f.m <= 0) continue;
               ms += f.m;
               ps += f.m * Vec3(f.p[0], f.p[1], f.p[2]);
               ++cnt;
             }
-            if (cnt < 2 || ms < Real(0.9999) * m) continue;  // one shell, or bulk material
-            if (skip && skip(c + Vec3i(n >> 4, (n >> 2) & 3, n & 3))) continue;
-            const Vec3 v0 = ps / ms;
+            const Real mk = cn.m - ms;  // the bulk material's share
+            const bool bulk = mk >= kBulkMin * cn.m;
+            if (cnt == 0 || cnt + (bulk ? 1 : 0) < 2) continue;
+            if (!bulk && mk > kShellOnly * cn.m) continue;  // a sliver of bulk: one velocity
+            const Vec3 p(cn.v[0], cn.v[1], cn.v[2]);
+            const Vec3 v0 = p / cn.m;
+            Vec3 vk = bulk ? Vec3((p - ps) / mk) : Vec3::Zero();
             for (std::size_t s = 0; s < K; ++s) {
               if (fb[s] < 0) continue;
-              const Node& f = grids_[s].nodes[fb[s]][n];
-              if (f.m > 0) grids_[s].r[fb[s]][n] = Vec3(f.p[0], f.p[1], f.p[2]) - v0;
+              const Node& f = fields_[s].nodes[fb[s]][n];
+              if (f.m <= 0) continue;
+              Vec3 vs(f.p[0], f.p[1], f.p[2]);
+              if (bulk) bulk_contact(f, friction_[s], mk, vk, vs);
+              fields_[s].r[fb[s]][n] = vs - v0;
             }
+            if (bulk) r_bulk_[g][n] = vk - v0;
+            shared_[g] |= std::uint64_t(1) << n;
           }
         }
       },
       serial);
+}
+
+void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial) {
+  const std::size_t K = fields_.size();
+  parallel_for(
+      combined.num_grid_blocks(), 4,
+      [&](std::size_t gb, std::size_t ge) {
+        for (std::size_t g = gb; g < ge; ++g) {
+          if (!shared_[g]) continue;
+          const int* fb = fblock_.data() + g * K;
+          const Vec3i c = unpack_block(combined.gblock_key[g]) * kBlockSize;
+          for (int n = 0; n < kBlockNodes; ++n) {
+            if (!(shared_[g] >> n & 1)) continue;
+            const bool one = skip && skip(c + Vec3i(n >> 4, (n >> 2) & 3, n & 3));
+            const Vec3 rk = r_bulk_[g][n];
+            for (std::size_t s = 0; s < K; ++s) {
+              if (fb[s] < 0) continue;
+              Vec3& r = fields_[s].r[fb[s]][n];
+              r = one ? Vec3::Zero() : Vec3(r - rk);
+            }
+            if (one) continue;
+            GridNode& nd = combined.gblock_nodes[g][n];
+            for (int a = 0; a < 3; ++a) nd.v[a] += rk[a];
+          }
+        }
+      },
+      serial);
+}
+
+void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial) {
+  const std::size_t K = fields_.size();
   // Control points read their shell's relative velocity.
   for (std::size_t s = 0; s < K; ++s) {
-    Field& F = grids_[s];
+    Field& F = fields_[s];
     GridShell& gs = shells[s];
     ShellObject& sh = *gs.shell;
     const Real c_scale = Real(4) / static_cast<Real>(F.grid.dx());

@@ -1,20 +1,29 @@
-// A velocity field per shell on grid nodes that several shells share, so that shells in
-// contact slide past each other as Coulomb says (multi-field MPM, Bardenhagen et al.
-// 2000).
+// A velocity field per shell, and one for all bulk material, on grid nodes that they
+// share, so that shells in contact slide as Coulomb says (multi-field MPM, Bardenhagen
+// et al. 2000, with the contact itself left to the contact particles).
 //
 // With one velocity per node, two sheets resting ~2 dx apart share the nodes between
 // them and every transfer averages their velocities there: an inelastic, no-slip drag
 // on top of the contact friction, which made a frictionless sheet slide at a third of
-// g sin on another (README, "Contact"). Here each shell also transfers its control
-// points to its own grid (mass and the same APIC momentum with its forces). At a node
-// that only shells share, shell b reads its own velocity plus everything the grid update
-// added there (gravity, the contact particles' normal forces):
+// g sin on another and dragged blocks off with a pulled table cloth (README, "Contact").
+// Here each shell also transfers its control points to its own grid (mass and the same
+// APIC momentum with its forces); the bulk material's share is the rest of the node. At
+// a shared node each body b reads its own velocity plus everything the grid update added
+// there (gravity, the contact particles' normal forces):
 //   v_b = v + (v_b^0 - v^0),
-// v^0 and v the combined velocity before and after the update, v_b^0 = p_b / m_b. The
-// shells then interact there only through the contact particles (normal elasticity and
-// the Coulomb return mapping), which is what the method prescribes; sum m_b v_b = m v,
-// so momentum is unchanged. Nodes with bulk material, colliders or walls keep one
-// velocity, as does a shell in contact with itself.
+// v^0 and v the node's velocity before and after the update, v_b^0 = p_b / m_b. Bodies
+// then interact there only through the contact particles (normal elasticity and the
+// Coulomb return mapping), as the method prescribes; sum m_b v_b = m v, so momentum is
+// unchanged. Bulk materials share one field (sand on snow stays single-field MPM), as do
+// the folds of one shell. Nodes on colliders or walls, and nodes where the bulk share is
+// too small to separate from round-off (under 1e-3 of the mass), keep one velocity.
+//
+// Bulk material has no contact particles of its own and fills every node near a shell
+// it touches, so the contact particles alone cannot keep it out. Between a shell and the
+// bulk field the node applies Bardenhagen's rule with the shell's normal n (turned to the
+// node's side): when they approach, they share the normal velocity, and their relative
+// tangential velocity drops by c_F times the normal one (sticking at zero); when they
+// separate, each keeps its own. Momentum is exchanged in equal and opposite parts.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -32,34 +41,49 @@ class ShellFields {
   /// a wall).
   using SkipFn = std::function<bool(const Vec3i& node)>;
 
-  /// Grid geometry and the number of grid shells (fields are kept for two or more).
-  void setup(const SparseGrid& grid, std::size_t num_shells);
-  bool active() const { return grids_.size() >= 2; }
+  /// Grid geometry, the number of grid shells and whether there is bulk material: fields
+  /// are kept when there are two bodies or more (two shells, or a shell and bulk).
+  void setup(const SparseGrid& grid, std::size_t num_shells, bool bulk);
+  bool active() const { return active_; }
 
-  /// Per shell: bins its control points and transfers mass and momentum m v + dt f +
-  /// APIC to its own grid. Call after the combined P2G, before any
-  /// control point moves.
-  void p2g(const std::vector<GridShell>& shells, Real dt, bool serial);
-
-  /// After the combined G2P: r_b = v_b^0 - v^0 at nodes only shells share, then each
-  /// control point gets v += sum w r_b, x += dt sum w r_b and C += the matching APIC
-  /// term (held components unchanged).
-  void correct(const SparseGrid& combined, std::vector<GridShell>& shells, Real dt,
-                      const SkipFn& skip, bool serial);
+  /// Right after the combined P2G (the combined grid holds mass and momentum): each
+  /// shell's own P2G, and the relative velocities v_b^0 - v^0 of every body at the nodes
+  /// two bodies share.
+  void p2g(const SparseGrid& combined, const std::vector<GridShell>& shells, Real dt,
+           bool serial);
+  /// After the grid update, before G2P: drops the relative velocities where skip() says
+  /// so, and gives shared nodes the bulk field's velocity (bulk particles, contact
+  /// particles and the shells' plain G2P then read it).
+  void before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial);
+  /// After G2P: each control point gets v += sum w r, x += dt sum w r and C += the
+  /// matching APIC term, r its shell's velocity relative to the node's (held components
+  /// unchanged).
+  void after_g2p(std::vector<GridShell>& shells, Real dt, bool serial);
 
  private:
   struct Node {
     Real m;
     Real p[3];  ///< momentum; velocity after p2g()
+    Real n[3];  ///< sum of w m n_j, n_j the shell normal turned to the node's side
   };
   struct Field {
     SparseGrid grid;  ///< binning of this shell's control points (its nodes unused)
     std::vector<std::array<Node, kPadNodes>> buf;
     std::vector<std::array<Node, kBlockNodes>> nodes;
-    std::vector<std::array<Vec3, kBlockNodes>> r;  ///< relative velocity per node
+    std::vector<std::array<Vec3, kBlockNodes>> r;  ///< velocity relative to the node
     std::vector<Vec3> x0;                          ///< control points at p2g time
+    std::vector<Vec3> normal;                      ///< control-point unit normals
   };
-  std::vector<Field> grids_;
+  void shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial);
+  static void bulk_contact(const Node& f, Real friction, Real mk, Vec3& vk, Vec3& vs);
+  bool active_ = false;
+  std::vector<Field> fields_;
+  std::vector<Real> friction_;  ///< per shell: c_F against bulk material
+  // Per combined grid block: the fields' block indices (-1: absent), the bulk field's
+  // relative velocity and a bit per node that has relative velocities.
+  std::vector<int> fblock_;
+  std::vector<std::array<Vec3, kBlockNodes>> r_bulk_;
+  std::vector<std::uint64_t> shared_;
 };
 
 }  // namespace shellmpm

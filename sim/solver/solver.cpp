@@ -104,7 +104,8 @@ void Solver::setup_contact() {
     grid_shells_.push_back(std::move(g));
   }
   shell_table_.build(grid_shells_);
-  shell_fields_.setup(grid_, scene_.shot.shared_shell_velocity ? 0 : grid_shells_.size());
+  shell_fields_.setup(grid_, scene_.shot.shared_shell_velocity ? 0 : grid_shells_.size(),
+                      !scene_.sources.empty());
 }
 
 TransferParams Solver::transfer_params() {
@@ -186,7 +187,8 @@ void Solver::add_grid_stages() {
                            shell_p2g_block(grid_, shell_table_, grid_shells_, dt, b, buf);
                          };
                        particles_to_grid(particles_, grid_, tp);
-                       if (shell_fields_.active()) shell_fields_.p2g(grid_shells_, dt, opt_.serial);
+                       if (shell_fields_.active())
+                         shell_fields_.p2g(grid_, grid_shells_, dt, opt_.serial);
                      }});
   stages_.push_back({"grid", [this] { grid_update(); }});
   if (on_grid)
@@ -203,11 +205,13 @@ void Solver::add_grid_stages() {
                          tp.others = [this, dt](std::size_t b, GridNode* buf) {
                            shell_g2p_block(grid_, shell_table_, grid_shells_, dt, b, buf);
                          };
+                       const bool fields = shell_fields_.active();
+                       if (fields)
+                         shell_fields_.before_g2p(
+                             grid_, [this](const Vec3i& n) { return single_velocity_node(n); },
+                             opt_.serial);
                        grid_to_particles(particles_, grid_, tp);
-                       if (shell_fields_.active())
-                         shell_fields_.correct(
-                             grid_, grid_shells_, dt,
-                             [this](const Vec3i& n) { return single_velocity_node(n); }, opt_.serial);
+                       if (fields) shell_fields_.after_g2p(grid_shells_, dt, opt_.serial);
                        clamp_to_domain();
                      }});
   if (on_grid)
