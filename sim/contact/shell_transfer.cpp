@@ -83,17 +83,24 @@ void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
     const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
     const Vec3 base = m * sh.v[j] + dt * gs.force[j] - A * fx;
     const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-    for (int i = 0; i < 3; ++i)
-      for (int jj = 0; jj < 3; ++jj)
+    // Factored as in sim/mpm/transfer.cpp: A (node - fx) = A (-fx) + A.col(0) i + ...
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 bi = base + Real(i) * A.col(0);
+      for (int jj = 0; jj < 3; ++jj) {
+        const Vec3 bij = bi + Real(jj) * A.col(1);
+        const Real wxy = W.w[0][i] * W.w[1][jj];
+        GridNode* row = &buf[pad_node(lx + i, ly + jj, lz)];
         for (int k = 0; k < 3; ++k) {
-          const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];
-          const Vec3 mom = w * (base + A * Vec3(Real(i), Real(jj), Real(k)));
-          GridNode& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
+          const Real w = wxy * W.w[2][k];
+          const Vec3 mom = w * (bij + Real(k) * A.col(2));
+          GridNode& nd = row[k];
           nd.m += w * m;
           nd.v[0] += mom[0];
           nd.v[1] += mom[1];
           nd.v[2] += mom[2];
         }
+      }
+    }
   }
 }
 
@@ -112,18 +119,32 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
       ShellObject& sh = *gs.shell;
       const QuadraticWeights W(grid.grid_coord(sh.x[j]));
       const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-      const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-      Vec3 v = Vec3::Zero();
-      Mat3 B = Mat3::Zero();
-      for (int i = 0; i < 3; ++i)
-        for (int jj = 0; jj < 3; ++jj)
+      // Sums of w v, w v i, w v j, w v k over the nodes, built per axis.
+      Vec3 v = Vec3::Zero(), vi_sum = Vec3::Zero(), vj_sum = Vec3::Zero(), vk_sum = Vec3::Zero();
+      for (int i = 0; i < 3; ++i) {
+        Vec3 P = Vec3::Zero(), Pj = Vec3::Zero(), Pk = Vec3::Zero();
+        for (int jj = 0; jj < 3; ++jj) {
+          const GridNode* row = &buf[pad_node(lx + i, ly + jj, lz)];
+          Vec3 Q = Vec3::Zero(), Qk = Vec3::Zero();
           for (int k = 0; k < 3; ++k) {
-            const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];
-            const GridNode& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
-            const Vec3 vn(nd.v[0], nd.v[1], nd.v[2]);
-            v += w * vn;
-            B += (w * vn) * (Vec3(Real(i), Real(jj), Real(k)) - fx).transpose();
+            const Vec3 wv = W.w[2][k] * Vec3(row[k].v[0], row[k].v[1], row[k].v[2]);
+            Q += wv;
+            Qk += Real(k) * wv;
           }
+          P += W.w[1][jj] * Q;
+          Pj += (W.w[1][jj] * Real(jj)) * Q;
+          Pk += W.w[1][jj] * Qk;
+        }
+        v += W.w[0][i] * P;
+        vi_sum += (W.w[0][i] * Real(i)) * P;
+        vj_sum += W.w[0][i] * Pj;
+        vk_sum += W.w[0][i] * Pk;
+      }
+      // B = sum w v (node - fx)^T in grid units.
+      Mat3 B;
+      B.col(0) = vi_sum - W.fx[0] * v;
+      B.col(1) = vj_sum - W.fx[1] * v;
+      B.col(2) = vk_sum - W.fx[2] * v;
       gs.contact->C[j] = (Real(4) / dx) * B;  // B D^-1 with B in grid units times dx
       const std::uint8_t held = gs.held[j];
       for (int a = 0; a < 3; ++a)
@@ -134,19 +155,21 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
       auto node = [&](int i, int jj, int k) -> const GridNode& {
         return buf[pad_node(i - bc[0], jj - bc[1], k - bc[2])];
       };
-      const SiteStencil st =
-          site_stencil(grid, c.x[j], [&](int i, int jj, int k) { return node(i, jj, k).m; });
-      if (!st.any) continue;
-      Mat3 gradv = Mat3::Zero();
+      const SiteMoments sm =
+          site_moments(grid, c.x[j], [&](int i, int jj, int k) { return node(i, jj, k).m; });
+      if (!sm.any) continue;
+      // grad~v a3E = sum_n v_n (g_n . a3E); nodes without mass have g_n = 0.
+      Real ga[27];
+      sm.dot(c.a3e[j], ga);
+      Vec3 gradv_a3 = Vec3::Zero();
       int n = 0;
       for (int i = 0; i < 3; ++i)
-        for (int jj = 0; jj < 3; ++jj)
-          for (int k = 0; k < 3; ++k, ++n) {
-            if (!st.massive[n]) continue;
-            const GridNode& nd = node(st.base[0] + i, st.base[1] + jj, st.base[2] + k);
-            gradv += Vec3(nd.v[0], nd.v[1], nd.v[2]) * st.grad[n].transpose();
-          }
-      c.a3e[j] += dt * (gradv * c.a3e[j]);
+        for (int jj = 0; jj < 3; ++jj) {
+          const GridNode* row = &node(sm.base[0] + i, sm.base[1] + jj, sm.base[2]);
+          for (int k = 0; k < 3; ++k, ++n)
+            gradv_a3 += ga[n] * Vec3(row[k].v[0], row[k].v[1], row[k].v[2]);
+        }
+      c.a3e[j] += dt * gradv_a3;
     }
   }
 }
@@ -174,18 +197,19 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
             const Vec3& G3 = c.G3[p];
             if (G3.squaredNorm() == 0) continue;
             auto at = [&](int i, int j, int k) { return pad_node(i - bc[0], j - bc[1], k - bc[2]); };
-            const SiteStencil st =
-                site_stencil(grid, c.x[p], [&](int i, int j, int k) { return mass[at(i, j, k)]; });
-            if (!st.any) continue;
-            const Vec3 a3 = c.a3e[p];
-            const Real V = c.volume[p];
+            const SiteMoments sm =
+                site_moments(grid, c.x[p], [&](int i, int j, int k) { return mass[at(i, j, k)]; });
+            if (!sm.any) continue;
+            Real ga[27];
+            sm.dot(c.a3e[p], ga);
+            const Real s0 = -dt * c.volume[p];
             int n = 0;
             for (int i = 0; i < 3; ++i)
               for (int j = 0; j < 3; ++j)
                 for (int k = 0; k < 3; ++k, ++n) {
-                  if (!st.massive[n]) continue;
-                  const int id = at(st.base[0] + i, st.base[1] + j, st.base[2] + k);
-                  const Vec3 dv = (-dt * V * st.grad[n].dot(a3) / mass[id]) * G3;
+                  if (!sm.massive[n]) continue;
+                  const int id = at(sm.base[0] + i, sm.base[1] + j, sm.base[2] + k);
+                  const Vec3 dv = (s0 * ga[n] / mass[id]) * G3;
                   buf[id].v[0] += dv[0];
                   buf[id].v[1] += dv[1];
                   buf[id].v[2] += dv[2];

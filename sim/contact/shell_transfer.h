@@ -71,6 +71,93 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
 void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
                            const std::vector<GridShell>& shells, Real dt, bool serial);
 
+/// The moments behind the gradient weights of a point's 27 stencil nodes (node
+/// n = 9 i + 3 j + k): a[n] = w_n m_n (0 for nodes without mass), the centred offsets per
+/// axis e[axis][o] = dx (o - fx) - dbar (world units, so d_n - dbar = (e[0][i], e[1][j],
+/// e[2][k])) and Minv = M^-1; g_n = a[n] Minv (d_n - dbar). M is built from the marginal
+/// sums of a over the stencil (the offsets are separable), which is the same sum as the
+/// 27 outer products up to round-off.
+struct SiteMoments {
+  int base[3];
+  Real w[27];
+  Real a[27];
+  bool massive[27];
+  Real e[3][3];
+  Mat3 Minv;
+  bool any = false;  ///< false: no stencil node has mass (e and Minv unset)
+  /// g_n . u for all 27 nodes: a[n] (d_n - dbar) . (Minv^T u).
+  void dot(const Vec3& u, Real out[27]) const {
+    const Vec3 q = Minv.transpose() * u;
+    int n = 0;
+    for (int i = 0; i < 3; ++i) {
+      const Real si = e[0][i] * q[0];
+      for (int j = 0; j < 3; ++j) {
+        const Real sij = si + e[1][j] * q[1];
+        for (int k = 0; k < 3; ++k, ++n) out[n] = a[n] * (sij + e[2][k] * q[2]);
+      }
+    }
+  }
+};
+/// mass(i, j, k): mass of the node with global grid index (i, j, k).
+template <class MassFn>
+SiteMoments site_moments(const SparseGrid& grid, const Vec3& x, MassFn mass) {
+  SiteMoments sm;
+  const QuadraticWeights W(grid.grid_coord(x));
+  const Real dx = static_cast<Real>(grid.dx());
+  for (int a = 0; a < 3; ++a) sm.base[a] = W.base[a];
+  // Two-axis marginals of a: Aij = sum_k a, Aik = sum_j a, Ajk = sum_i a.
+  Real Aij[3][3] = {}, Aik[3][3] = {}, Ajk[3][3] = {};
+  int n = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const Real wxy = W.w[0][i] * W.w[1][j];
+      for (int k = 0; k < 3; ++k, ++n) {
+        sm.w[n] = wxy * W.w[2][k];
+        const Real m = mass(W.base[0] + i, W.base[1] + j, W.base[2] + k);
+        sm.massive[n] = m > 0;
+        const Real an = sm.massive[n] ? sm.w[n] * m : Real(0);
+        sm.a[n] = an;
+        Aij[i][j] += an;
+        Aik[i][k] += an;
+        Ajk[j][k] += an;
+      }
+    }
+  Real A[3][3];  // one-axis marginals A[axis][o]
+  for (int o = 0; o < 3; ++o) {
+    A[0][o] = Aij[o][0] + Aij[o][1] + Aij[o][2];
+    A[1][o] = Aij[0][o] + Aij[1][o] + Aij[2][o];
+    A[2][o] = Aik[0][o] + Aik[1][o] + Aik[2][o];
+  }
+  const Real asum = A[0][0] + A[0][1] + A[0][2];
+  sm.any = asum > 0;
+  if (!sm.any) return sm;
+  for (int ax = 0; ax < 3; ++ax) {
+    Real d[3];
+    for (int o = 0; o < 3; ++o) d[o] = dx * (Real(o) - W.fx[ax]);
+    const Real dbar = (A[ax][0] * d[0] + A[ax][1] * d[1] + A[ax][2] * d[2]) / asum;
+    for (int o = 0; o < 3; ++o) sm.e[ax][o] = d[o] - dbar;
+  }
+  // Regularised by 1e-3 of the full-stencil moment (asum dx^2 / 4) in case the nodes with
+  // mass are (nearly) coplanar.
+  const Real reg = Real(2.5e-4) * asum * dx * dx;
+  Mat3 M;
+  for (int ax = 0; ax < 3; ++ax)
+    M(ax, ax) = reg + A[ax][0] * sm.e[ax][0] * sm.e[ax][0] + A[ax][1] * sm.e[ax][1] * sm.e[ax][1] +
+                A[ax][2] * sm.e[ax][2] * sm.e[ax][2];
+  Real mxy = 0, mxz = 0, myz = 0;
+  for (int p = 0; p < 3; ++p)
+    for (int r = 0; r < 3; ++r) {
+      mxy += Aij[p][r] * sm.e[0][p] * sm.e[1][r];
+      mxz += Aik[p][r] * sm.e[0][p] * sm.e[2][r];
+      myz += Ajk[p][r] * sm.e[1][p] * sm.e[2][r];
+    }
+  M(0, 1) = M(1, 0) = mxy;
+  M(0, 2) = M(2, 0) = mxz;
+  M(1, 2) = M(2, 1) = myz;
+  sm.Minv = M.inverse();
+  return sm;
+}
+
 /// The 27 stencil nodes of a point with the mass-weighted gradient weights g_i described
 /// above (world units, 1/m); `massive[k]` false for nodes without mass (g = 0 there).
 struct SiteStencil {
@@ -83,39 +170,29 @@ struct SiteStencil {
 /// mass(i, j, k): mass of the node with global grid index (i, j, k).
 template <class MassFn>
 SiteStencil site_stencil(const SparseGrid& grid, const Vec3& x, MassFn mass) {
+  const SiteMoments sm = site_moments(grid, x, mass);
   SiteStencil st;
-  const QuadraticWeights W(grid.grid_coord(x));
-  const Real dx = static_cast<Real>(grid.dx());
-  for (int a = 0; a < 3; ++a) st.base[a] = W.base[a];
-  Real a[27];
-  Vec3 d[27];
-  Real asum = 0;
-  Vec3 dsum = Vec3::Zero();
-  int n = 0;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      for (int k = 0; k < 3; ++k, ++n) {
-        st.w[n] = W.w[0][i] * W.w[1][j] * W.w[2][k];
-        d[n] = dx * Vec3(Real(i) - W.fx[0], Real(j) - W.fx[1], Real(k) - W.fx[2]);
-        const Real m = mass(W.base[0] + i, W.base[1] + j, W.base[2] + k);
-        st.massive[n] = m > 0;
-        a[n] = st.massive[n] ? st.w[n] * m : Real(0);
-        asum += a[n];
-        dsum += a[n] * d[n];
-      }
-  st.any = asum > 0;
+  for (int a = 0; a < 3; ++a) st.base[a] = sm.base[a];
+  for (int n = 0; n < 27; ++n) {
+    st.w[n] = sm.w[n];
+    st.massive[n] = sm.massive[n];
+  }
+  st.any = sm.any;
   if (!st.any) {
-    for (n = 0; n < 27; ++n) st.grad[n].setZero();
+    for (int n = 0; n < 27; ++n) st.grad[n].setZero();
     return st;
   }
-  const Vec3 dbar = dsum / asum;
-  // Regularised by 1e-3 of the full-stencil moment (asum dx^2 / 4) in case the nodes with
-  // mass are (nearly) coplanar.
-  Mat3 M = (Real(2.5e-4) * asum * dx * dx) * Mat3::Identity();
-  for (n = 0; n < 27; ++n)
-    if (a[n] > 0) M += a[n] * (d[n] - dbar) * (d[n] - dbar).transpose();
-  const Mat3 Minv = M.inverse();
-  for (n = 0; n < 27; ++n) st.grad[n] = a[n] > 0 ? Vec3(a[n] * (Minv * (d[n] - dbar))) : Vec3::Zero();
+  // Minv (d_n - dbar) = e[0][i] Minv.col(0) + e[1][j] Minv.col(1) + e[2][k] Minv.col(2).
+  int n = 0;
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 ci = sm.e[0][i] * sm.Minv.col(0);
+    for (int j = 0; j < 3; ++j) {
+      const Vec3 cij = ci + sm.e[1][j] * sm.Minv.col(1);
+      for (int k = 0; k < 3; ++k, ++n)
+        st.grad[n] =
+            sm.a[n] > 0 ? Vec3(sm.a[n] * (cij + sm.e[2][k] * sm.Minv.col(2))) : Vec3::Zero();
+    }
+  }
   return st;
 }
 
