@@ -1,5 +1,6 @@
 #include "sim/contact/shell_fields.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "sim/core/parallel.h"
@@ -26,9 +27,12 @@ void ShellFields::bulk_contact(const Node& f, Real friction, Real mk, Vec3& vk, 
   const Real drop = -friction * un;
   ut = tl <= drop ? Vec3::Zero() : Vec3(ut * (1 - drop / tl));
   const Vec3 du = ut - u;  // the new relative velocity is ut
-  const Real mt = mk + f.m;
-  vk += (f.m / mt) * du;
-  vs -= (mk / mt) * du;
+  // Split in inverse proportion to the masses; the pinned share of the shell does not move.
+  const Real free = std::max(f.m - f.held, Real(0));
+  // (the shell's effective mass m^2 / free: m when nothing is pinned, infinite when all is).
+  const Real to_bulk = f.m * f.m / (f.m * f.m + mk * free);
+  vk += to_bulk * du;
+  vs -= (1 - to_bulk) * du;
 }
 
 void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bulk) {
@@ -73,6 +77,7 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
             const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
             const Vec3 base = m * sh.v[j] + dt * gs.force[j] - A * fx;
           const Vec3& nj = F.normal[j];
+          const Real mh = gs.held[j] == 7 ? m : Real(0);
             const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
             for (int i = 0; i < 3; ++i)
               for (int jj = 0; jj < 3; ++jj)
@@ -84,6 +89,7 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
                   const Real wn = side > 0 ? w * m : side < 0 ? -w * m : Real(0);
                   Node& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
                   nd.m += w * m;
+                  nd.held += w * mh;
                   for (int a = 0; a < 3; ++a) {
                     nd.p[a] += mom[a];
                     nd.n[a] += wn * nj[a];
@@ -104,6 +110,7 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
             const Node& from = F.buf[src][sn];
             Node& d = nodes[dn];
             d.m += from.m;
+            d.held += from.held;
             for (int a = 0; a < 3; ++a) {
               d.p[a] += from.p[a];
               d.n[a] += from.n[a];

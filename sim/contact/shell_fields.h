@@ -23,7 +23,8 @@
 // bulk field the node applies Bardenhagen's rule with the shell's normal n (turned to the
 // node's side): when they approach, they share the normal velocity, and their relative
 // tangential velocity drops by c_F times the normal one (sticking at zero); when they
-// separate, each keeps its own. Momentum is exchanged in equal and opposite parts.
+// separate, each keeps its own. Momentum is exchanged in equal and opposite parts, with
+// the shell's pinned share counted as infinitely heavy (a pinned sheet holds a block up).
 #pragma once
 #include <array>
 #include <cstdint>
@@ -65,6 +66,7 @@ class ShellFields {
     Real m;
     Real p[3];  ///< momentum; velocity after p2g()
     Real n[3];  ///< sum of w m n_j, n_j the shell normal turned to the node's side
+    Real held;  ///< mass of fully pinned control points
   };
   struct Field {
     SparseGrid grid;  ///< binning of this shell's control points (its nodes unused)
