@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <sstream>
 
@@ -373,23 +374,33 @@ double Solver::stable_dt() const {
           // Squared wave speeds, from the deformed state F (a material stiffens or softens
           // as it is squeezed); one square root per chunk.
           Real v2 = 0, c2 = 0;
+          bool finite = true;
           for (std::size_t p = b; p < e; ++p) {
-            v2 = std::max(v2, particles_.v[p].squaredNorm());
+            const Real sq = particles_.v[p].squaredNorm();
+            finite = finite && std::isfinite(sq);
+            v2 = std::max(v2, sq);
             const auto mat = particles_.material[p];
             c2 = std::max(c2, models_[mat].wave_modulus(
                                   particles_.F[p],
                                   particles_.has_plastic() ? particles_.plastic[p] : Real(1)) /
                                   densities_[mat]);
           }
-          vm[b / kParticleGrain] = std::sqrt(static_cast<double>(v2));
+          vm[b / kParticleGrain] =
+              finite ? std::sqrt(static_cast<double>(v2)) : std::numeric_limits<double>::quiet_NaN();
           cm[b / kParticleGrain] = std::sqrt(c2);
         },
         opt_.serial);
+    for (double v : vm)
+      if (!std::isfinite(v)) return v;  // diverged
     vmax = *std::max_element(vm.begin(), vm.end());
     cmax = *std::max_element(cm.begin(), cm.end());
   }
   for (const GridShell& g : grid_shells_)
-    for (const Vec3& v : g.shell->v) vmax = std::max(vmax, static_cast<double>(v.norm()));
+    for (const Vec3& v : g.shell->v) {
+      const double sp = static_cast<double>(v.norm());
+      if (!std::isfinite(sp)) return sp;  // diverged
+      vmax = std::max(vmax, sp);
+    }
   for (const Collider& c : colliders_) vmax = std::max(vmax, c.max_speed(time_));
   if (vmax > 0) dt = std::min(dt, s.cfl * s.dx / vmax);
   if (cmax > 0) dt = std::min(dt, s.cfl * s.dx / cmax);
@@ -407,6 +418,12 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
     const auto d0 = clock::now();
     double dt = stable_dt();
     const double remaining = t_end - time_;
+    if (!std::isfinite(dt)) {
+      std::ostringstream os;
+      os << "at t = " << time_ << " s the simulation diverged (a velocity is not finite); "
+         << "try a smaller shot.cfl, or a stiffer contact or smaller dx for fast contact";
+      throw SimulationError(os.str());
+    }
     if (dt < scene_.shot.dt_min && remaining > scene_.shot.dt_min) {
       std::ostringstream os;
       os << "at t = " << time_ << " s the stable step " << dt << " s is below shot.dt_min = "

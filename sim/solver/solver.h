@@ -46,7 +46,7 @@ class Solver {
   /// Computes the energy, momentum and speed entries of a FrameStats for the current state.
   void measure(FrameStats& s) const;
   /// The step the solver would take now, before splitting the remaining frame time.
-  double stable_dt() const;
+  double stable_dt() const;  // NaN when a velocity is not finite (diverged)
 
   double time() const { return time_; }
   void set_time(double t) { time_ = t; }

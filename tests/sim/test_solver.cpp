@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
@@ -190,4 +192,19 @@ TEST_CASE("stages follow the scene: nothing to simulate gives no stages", "[solv
   REQUIRE(snow.stage_names() ==
           std::vector<std::string>{"bin", "p2g", "grid", "g2p", "plasticity", "emit"});
   REQUIRE(snow.particles().size() == 0);  // emitting sources start empty
+}
+
+TEST_CASE("a non-finite velocity stops the run with a divergence error, not a crash", "[solver]") {
+  Scene s = block_scene();
+  Solver solver(s);
+  solver.advance_to(1.0 / 24);
+  REQUIRE(std::isfinite(solver.stable_dt()));
+  solver.particles().v[3] = Vec3(std::numeric_limits<Real>::quiet_NaN(), 0, 0);
+  CHECK(std::isnan(solver.stable_dt()));
+  try {
+    solver.advance_to(2.0 / 24);
+    FAIL("no error");
+  } catch (const SimulationError& e) {
+    CHECK(std::string(e.what()).find("diverged") != std::string::npos);
+  }
 }
