@@ -1,6 +1,7 @@
 #include "sim/contact/shell_fields.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "sim/core/parallel.h"
@@ -10,29 +11,27 @@ namespace shellmpm {
 namespace {
 constexpr Real kBulkMin = Real(1e-3);    ///< bulk share of a node's mass that gets a field
 constexpr Real kShellOnly = Real(1e-4);  ///< below this bulk share the node is shells only
+/// Two shells closer than this (in cells) at a node share their normal velocity there.
+constexpr Real kFloorCells = Real(1);
 }  // namespace
 
-// Bardenhagen's contact between the bulk field (mass mk, velocity vk) and a shell's
-// field f (velocity vs) at one node; the node is on the side of the shell f.n points to.
-void ShellFields::bulk_contact(const Node& f, Real friction, Real mk, Vec3& vk, Vec3& vs) {
-  const Vec3 nsum(f.n[0], f.n[1], f.n[2]);
-  const Real nl = nsum.norm();
-  if (!(nl > 0)) return;
-  const Vec3 nrm = nsum / nl;
-  const Vec3 u = vk - vs;  // bulk relative to the shell
-  const Real un = u.dot(nrm);
+// Bardenhagen's contact between two fields a and b at one node: n the unit normal from a
+// towards b, w the inverse masses (0: pinned). When they approach along n they end with
+// the same normal velocity, and their relative tangential velocity drops by c_F times the
+// relative normal one (sticking at zero); equal and opposite momentum changes.
+void ShellFields::contact_pair(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb) {
+  const Real w = wa + wb;
+  if (!(w > 0)) return;
+  const Vec3 u = vb - va;
+  const Real un = u.dot(n);
   if (un >= 0) return;  // separating
-  Vec3 ut = u - un * nrm;
+  Vec3 ut = u - un * n;
   const Real tl = ut.norm();
   const Real drop = -friction * un;
   ut = tl <= drop ? Vec3::Zero() : Vec3(ut * (1 - drop / tl));
-  const Vec3 du = ut - u;  // the new relative velocity is ut
-  // Split in inverse proportion to the masses; the pinned share of the shell does not move.
-  const Real free = std::max(f.m - f.held, Real(0));
-  // (the shell's effective mass m^2 / free: m when nothing is pinned, infinite when all is).
-  const Real to_bulk = f.m * f.m / (f.m * f.m + mk * free);
-  vk += to_bulk * du;
-  vs -= (1 - to_bulk) * du;
+  const Vec3 du = ut - u;
+  va -= (wa / w) * du;
+  vb += (wb / w) * du;
 }
 
 void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bulk) {
@@ -87,9 +86,11 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
                   // The normal turned to the node's side of the shell.
                   const Real side = nj.dot(Vec3(Real(i), Real(jj), Real(k)) - fx);
                   const Real wn = side > 0 ? w * m : side < 0 ? -w * m : Real(0);
+                  const Real wd = w * m * std::abs(side);
                   Node& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
                   nd.m += w * m;
                   nd.held += w * mh;
+                  nd.dist += wd;
                   for (int a = 0; a < 3; ++a) {
                     nd.p[a] += mom[a];
                     nd.n[a] += wn * nj[a];
@@ -111,6 +112,7 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
             Node& d = nodes[dn];
             d.m += from.m;
             d.held += from.held;
+            d.dist += from.dist;
             for (int a = 0; a < 3; ++a) {
               d.p[a] += from.p[a];
               d.n[a] += from.n[a];
@@ -139,6 +141,9 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   parallel_for(
       ng, 4,
       [&](std::size_t gb, std::size_t ge) {
+        std::vector<int> ids;
+        std::vector<Vec3> vel(K), nrm(K);
+        std::vector<Real> winv(K), dist(K);
         for (std::size_t g = gb; g < ge; ++g) {
           int* fb = fblock_.data() + g * K;
           int present = 0;
@@ -169,14 +174,37 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
             const Vec3 p(cn.v[0], cn.v[1], cn.v[2]);
             const Vec3 v0 = p / cn.m;
             Vec3 vk = bulk ? Vec3((p - ps) / mk) : Vec3::Zero();
+            // The shells here: velocity, normal towards the node, inverse effective mass
+            // (the pinned share infinitely heavy: m^2 / free).
+            ids.clear();
             for (std::size_t s = 0; s < K; ++s) {
               if (fb[s] < 0) continue;
               const Node& f = fields_[s].nodes[fb[s]][n];
               if (f.m <= 0) continue;
-              Vec3 vs(f.p[0], f.p[1], f.p[2]);
-              if (bulk) bulk_contact(f, friction_[s], mk, vk, vs);
-              fields_[s].r[fb[s]][n] = vs - v0;
+              const Vec3 ns(f.n[0], f.n[1], f.n[2]);
+              const Real nl = ns.norm();
+              ids.push_back(static_cast<int>(s));
+              vel[s] = Vec3(f.p[0], f.p[1], f.p[2]);
+              nrm[s] = nl > 0 ? Vec3(ns / nl) : Vec3::Zero();
+              winv[s] = std::max(f.m - f.held, Real(0)) / (f.m * f.m);
+              dist[s] = f.dist / f.m;
             }
+            // A floor under the contact particles: shells nearer than kFloorCells at this
+            // node (on opposite sides of it) may not approach further. Above it they meet
+            // only through the contact particles, whose friction is Coulomb's.
+            for (std::size_t i = 0; i < ids.size(); ++i)
+              for (std::size_t j = i + 1; j < ids.size(); ++j) {
+                const int a = ids[i], b = ids[j];
+                if (!(nrm[a].dot(nrm[b]) < Real(-0.5))) continue;
+                if (!(dist[a] + dist[b] < kFloorCells)) continue;
+                const Vec3 d = nrm[a] - nrm[b];
+                contact_pair(d / d.norm(), Real(0), winv[a], vel[a], winv[b], vel[b]);
+              }
+            if (bulk)
+              for (int a : ids)
+                if (nrm[a].squaredNorm() > 0)
+                  contact_pair(nrm[a], friction_[a], winv[a], vel[a], Real(1) / mk, vk);
+            for (int a : ids) fields_[a].r[fb[a]][n] = vel[a] - v0;
             if (bulk) r_bulk_[g][n] = vk - v0;
             shared_[g] |= std::uint64_t(1) << n;
           }

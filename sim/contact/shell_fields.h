@@ -67,6 +67,7 @@ class ShellFields {
     Real p[3];  ///< momentum; velocity after p2g()
     Real n[3];  ///< sum of w m n_j, n_j the shell normal turned to the node's side
     Real held;  ///< mass of fully pinned control points
+    Real dist;  ///< sum of w m |distance to the control point's tangent plane| [cells]
   };
   struct Field {
     SparseGrid grid;  ///< binning of this shell's control points (its nodes unused)
@@ -77,7 +78,7 @@ class ShellFields {
     std::vector<Vec3> normal;                      ///< control-point unit normals
   };
   void shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial);
-  static void bulk_contact(const Node& f, Real friction, Real mk, Vec3& vk, Vec3& vs);
+  static void contact_pair(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb);
   bool active_ = false;
   std::vector<Field> fields_;
   std::vector<Real> friction_;  ///< per shell: c_F against bulk material
