@@ -488,6 +488,11 @@ TEST_CASE("contact results are bit-identical serial and parallel", "[contact]") 
   s.shells.push_back(sheet("high", 0.24, 10, Vec3d(0.03, 0.08, -0.02)));
   s.shells.back().rotate_deg = Vec3d(0, 20, 5);
   s.shells.back().velocity = Vec3d(0, -1.5, 0.2);
+  // And a jelly block onto the lower sheet: shell-shell and shell-bulk fields both run.
+  MaterialDesc jelly;
+  jelly.name = "jelly";
+  jelly.youngs_modulus = 2e4;
+  add_box_source(s, jelly, Vec3d(-0.14, 0.03, -0.14), Vec3d(-0.08, 0.09, -0.08), Vec3d(0, -1, 0));
   SolverOptions serial_opt;
   serial_opt.serial = true;
   Solver a(s, serial_opt), b(s);
@@ -505,4 +510,5 @@ TEST_CASE("contact results are bit-identical serial and parallel", "[contact]") 
     CHECK(a.contact(i)->a3e == b.contact(i)->a3e);
   }
   CHECK(fa.friction_work == fb.friction_work);
+  CHECK(a.particles().x == b.particles().x);
 }
