@@ -11,8 +11,6 @@ namespace shellmpm {
 namespace {
 constexpr Real kBulkMin = Real(1e-3);    ///< bulk share of a node's mass that gets a field
 constexpr Real kShellOnly = Real(1e-4);  ///< below this bulk share the node is shells only
-/// Two shells closer than this (in cells) at a node share their normal velocity there.
-constexpr Real kFloorCells = Real(1);
 }  // namespace
 
 // Bardenhagen's contact between two fields a and b at one node: n the unit normal from a
@@ -86,11 +84,9 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
                   // The normal turned to the node's side of the shell.
                   const Real side = nj.dot(Vec3(Real(i), Real(jj), Real(k)) - fx);
                   const Real wn = side > 0 ? w * m : side < 0 ? -w * m : Real(0);
-                  const Real wd = w * m * std::abs(side);
                   Node& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
                   nd.m += w * m;
                   nd.held += w * mh;
-                  nd.dist += wd;
                   for (int a = 0; a < 3; ++a) {
                     nd.p[a] += mom[a];
                     nd.n[a] += wn * nj[a];
@@ -112,7 +108,6 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
             Node& d = nodes[dn];
             d.m += from.m;
             d.held += from.held;
-            d.dist += from.dist;
             for (int a = 0; a < 3; ++a) {
               d.p[a] += from.p[a];
               d.n[a] += from.n[a];
@@ -143,7 +138,7 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
       [&](std::size_t gb, std::size_t ge) {
         std::vector<int> ids;
         std::vector<Vec3> vel(K), nrm(K);
-        std::vector<Real> winv(K), dist(K);
+        std::vector<Real> winv(K);
         for (std::size_t g = gb; g < ge; ++g) {
           int* fb = fblock_.data() + g * K;
           int present = 0;
@@ -187,18 +182,16 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
               vel[s] = Vec3(f.p[0], f.p[1], f.p[2]);
               nrm[s] = nl > 0 ? Vec3(ns / nl) : Vec3::Zero();
               winv[s] = std::max(f.m - f.held, Real(0)) / (f.m * f.m);
-              dist[s] = f.dist / f.m;
             }
-            // A floor under the contact particles: shells nearer than kFloorCells at this
-            // node (on opposite sides of it) may not approach further. Above it they meet
-            // only through the contact particles, whose friction is Coulomb's.
+            // Shell against shell (on opposite sides of the node), then each shell against
+            // the bulk field: Bardenhagen's rule.
             for (std::size_t i = 0; i < ids.size(); ++i)
               for (std::size_t j = i + 1; j < ids.size(); ++j) {
                 const int a = ids[i], b = ids[j];
                 if (!(nrm[a].dot(nrm[b]) < Real(-0.5))) continue;
-                if (!(dist[a] + dist[b] < kFloorCells)) continue;
                 const Vec3 d = nrm[a] - nrm[b];
-                contact_pair(d / d.norm(), Real(0), winv[a], vel[a], winv[b], vel[b]);
+                contact_pair(d / d.norm(), std::sqrt(friction_[a] * friction_[b]), winv[a], vel[a],
+                             winv[b], vel[b]);
               }
             if (bulk)
               for (int a : ids)
@@ -275,12 +268,13 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
                     B += (w * rn) * (Vec3(Real(i), Real(jj), Real(k)) - fx).transpose();
                   }
               if (!any) continue;
+              // Pinned components keep their prescribed velocity, but their affine matrix
+              // still becomes the gradient of this shell's own field: left at the shared
+              // node's, a pinned sheet under a sliding block would carry the block's shear
+              // and the contact would see it moving.
               const std::uint8_t held = gs.held[j];
               for (int a = 0; a < 3; ++a)
-                if (held & (1u << a)) {
-                  dv[a] = 0;
-                  B.row(a).setZero();
-                }
+                if (held & (1u << a)) dv[a] = 0;
               sh.v[j] += dv;
               sh.x[j] += dt * dv;
               gs.contact->C[j] += c_scale * B;

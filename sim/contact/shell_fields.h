@@ -1,30 +1,31 @@
 // A velocity field per shell, and one for all bulk material, on grid nodes that they
-// share, so that shells in contact slide as Coulomb says (multi-field MPM, Bardenhagen
-// et al. 2000, with the contact itself left to the contact particles).
+// share, so that bodies in contact slide as Coulomb says (multi-field MPM, Bardenhagen et
+// al. 2000, "Contact algorithm for granular materials").
 //
 // With one velocity per node, two sheets resting ~2 dx apart share the nodes between
 // them and every transfer averages their velocities there: an inelastic, no-slip drag
 // on top of the contact friction, which made a frictionless sheet slide at a third of
 // g sin on another and dragged blocks off with a pulled table cloth (README, "Contact").
-// Here each shell also transfers its control points to its own grid (mass and the same
-// APIC momentum with its forces); the bulk material's share is the rest of the node. At
-// a shared node each body b reads its own velocity plus everything the grid update added
-// there (gravity, the contact particles' normal forces):
+// Here each shell also transfers its control points to its own grid (mass, the same
+// APIC momentum with its forces, and its normal turned to each node's side); the bulk
+// material's share is the rest of the node. At a shared node each body b reads its own
+// velocity plus everything the grid update added there (gravity, the contact particles'
+// normal forces):
 //   v_b = v + (v_b^0 - v^0),
-// v^0 and v the node's velocity before and after the update, v_b^0 = p_b / m_b. Bodies
-// then interact there only through the contact particles (normal elasticity and the
-// Coulomb return mapping), as the method prescribes; sum m_b v_b = m v, so momentum is
-// unchanged. Bulk materials share one field (sand on snow stays single-field MPM), as do
-// the folds of one shell. Nodes on colliders or walls, and nodes where the bulk share is
-// too small to separate from round-off (under 1e-3 of the mass), keep one velocity.
+// v^0 and v the node's velocity before and after the update, v_b^0 = p_b / m_b, after
+// Bardenhagen's rule between every pair of bodies there (two shells on opposite sides of
+// the node, or a shell and the bulk field), with n the shell normals: when they approach,
+// they share the normal velocity, and their relative tangential velocity drops by c_F
+// times the normal one (sticking at zero); when they separate, each keeps its own. c_F
+// is the shell material's friction (the geometric mean of two shells'). The changes are
+// equal and opposite, with a shell's pinned share counted as infinitely heavy, so
+// momentum is unchanged except through pins. The contact particles' elasticity and
+// return mapping act as before, through the grid forces.
 //
-// Bulk material has no contact particles of its own and fills every node near a shell
-// it touches, so the contact particles alone cannot keep it out. Between a shell and the
-// bulk field the node applies Bardenhagen's rule with the shell's normal n (turned to the
-// node's side): when they approach, they share the normal velocity, and their relative
-// tangential velocity drops by c_F times the normal one (sticking at zero); when they
-// separate, each keeps its own. Momentum is exchanged in equal and opposite parts, with
-// the shell's pinned share counted as infinitely heavy (a pinned sheet holds a block up).
+// Bulk materials share one field (sand on snow stays single-field MPM), as do the folds
+// of one shell (self-contact). Nodes on colliders or walls, and nodes where the bulk
+// share is too small to separate from round-off (under 1e-3 of the mass), keep one
+// velocity.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -67,7 +68,6 @@ class ShellFields {
     Real p[3];  ///< momentum; velocity after p2g()
     Real n[3];  ///< sum of w m n_j, n_j the shell normal turned to the node's side
     Real held;  ///< mass of fully pinned control points
-    Real dist;  ///< sum of w m |distance to the control point's tangent plane| [cells]
   };
   struct Field {
     SparseGrid grid;  ///< binning of this shell's control points (its nodes unused)
