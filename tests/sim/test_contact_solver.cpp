@@ -52,6 +52,17 @@ Scene contact_scene(double dx) {
   return s;
 }
 
+// A ground plane at y = -0.5 with friction 0.5.
+void add_ground(Scene& s) {
+  ColliderDesc ground;
+  ground.name = "ground";
+  ground.shape.kind = ShapeDesc::Kind::Plane;
+  ground.shape.point = Vec3d(0, -0.5, 0);
+  ground.shape.normal = Vec3d(0, 1, 0);
+  ground.friction = 0.5;
+  s.colliders.push_back(ground);
+}
+
 Vec3d total_momentum(const Solver& solver) {
   FrameStats fs;
   solver.measure(fs);
@@ -152,13 +163,7 @@ TEST_CASE("an elastic block hitting a sheet in zero gravity conserves momentum",
 
 TEST_CASE("a sheet dropped on another never passes through it", "[contact]") {
   Scene s = contact_scene(0.025);
-  ColliderDesc ground;
-  ground.name = "ground";
-  ground.shape.kind = ShapeDesc::Kind::Plane;
-  ground.shape.point = Vec3d(0, -0.5, 0);
-  ground.shape.normal = Vec3d(0, 1, 0);
-  ground.friction = 0.5;
-  s.colliders.push_back(ground);
+  add_ground(s);
   s.shells.push_back(sheet("bottom", 0.4, 16, Vec3d(0, -0.4, 0)));
   s.shells.push_back(sheet("top", 0.3, 12, Vec3d(0.02, -0.25, 0.01)));
   s.shells.back().rotate_deg = Vec3d(0, 30, 0);
@@ -202,13 +207,7 @@ TEST_CASE("a stack of five sheets rests on the ground for two seconds without in
   // velocities shared on approach (ShellFields) keep every pair apart.
   Scene s = contact_scene(0.025);
   s.shot.fps = 24;
-  ColliderDesc ground;
-  ground.name = "ground";
-  ground.shape.kind = ShapeDesc::Kind::Plane;
-  ground.shape.point = Vec3d(0, -0.5, 0);
-  ground.shape.normal = Vec3d(0, 1, 0);
-  ground.friction = 0.5;
-  s.colliders.push_back(ground);
+  add_ground(s);
   // Felt, as in scenes/sheet_stack.yaml: twice the cloth's thickness, stiffer.
   ShellMaterialDesc& felt = s.shell_materials[0];
   felt.youngs_modulus = 5e5;
