@@ -64,6 +64,12 @@ void Progress::message(const std::string& m) {
   std::fprintf(stderr, "%s\n", m.c_str());
 }
 
+void Progress::warning(const std::string& m) {
+  if (line_open_) std::fputs("\r\033[K", stderr);
+  line_open_ = false;
+  std::fprintf(stderr, "warning: %s\n", m.c_str());
+}
+
 void Progress::finish() {
   if (line_open_) std::fputs("\n", stderr);
   line_open_ = false;

@@ -17,6 +17,8 @@ class Progress {
   void substep(int frame, int sub, double dt, double t, std::size_t particles);
   void frame_done(const FrameStats& s);
   void message(const std::string& m);
+  /// "warning: m" on stderr, even with --quiet.
+  void warning(const std::string& m);
   void finish();
 
  private:

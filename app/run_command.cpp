@@ -59,6 +59,7 @@ int run_command(const RunArgs& a) {
     if (preview && !preview->render_frame(s.frame)) progress.message("error: " + preview->errors().back());
   };
   ro.log = [&](const std::string& m) { progress.message(m); };
+  ro.warn = [&](const std::string& m) { progress.warning(m); };
   const int n = run_shot(scene, ro);
   progress.finish();
   progress.message("wrote " + std::to_string(n) + " frames to " + scene.output.directory);

@@ -145,6 +145,7 @@ std::vector<KeySpec> build_schema() {
       Spec("shot.transfer", T::Enum).def("apic").choices({"apic", "mls"}),
       Spec("shot.shell_velocities", T::Enum).def("per_shell").choices({"per_shell", "shared"}),
       Spec("shot.units", T::String).def("m").nonempty(),
+      Spec("shot.on_integrity_failure", T::Enum).def("warn").choices({"warn", "stop"}),
       // materials
       Spec("materials[].name", T::String).required().nonempty().rule("unique"),
       Spec("materials[].type", T::Enum).required().choices({"elastic", "sand", "snow"}),
@@ -1369,6 +1370,9 @@ void read_shot(const DocNode& node, ShotSettings& shot) {
   shot.transfer = r.choice("transfer");
   shot.shared_shell_velocity = r.choice("shell_velocities") == "shared";
   shot.units = r.string("units");
+  shot.on_integrity_failure = r.choice("on_integrity_failure") == "stop"
+                                  ? ShotSettings::OnIntegrityFailure::Stop
+                                  : ShotSettings::OnIntegrityFailure::Warn;
   r.finish();
 }
 

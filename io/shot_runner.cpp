@@ -115,12 +115,24 @@ int run_shot(const Scene& scene, const RunOptions& opt) {
     if (frame == 1) {
       solver.measure(fs);  // frame 1 is the initial state
       fs.time = solver.time();
+      fs.integrity = solver.integrity_snapshot();
     } else {
       fs = solver.advance_to(t_end, [&](int sub, double dt, double t) {
         if (opt.on_substep) opt.on_substep(frame, sub, dt, t, solver.particles().size());
       });
     }
     fs.frame = frame;
+    if (fs.integrity.failed()) {
+      const std::vector<std::string> lines = describe_integrity(fs.integrity, frame, shot.dx);
+      for (const std::string& l : lines)
+        if (opt.warn) opt.warn(l);
+      if (shot.on_integrity_failure == ShotSettings::OnIntegrityFailure::Stop) {
+        // The frame's statistics are kept; its caches are not written (wrong physics).
+        stats.add(fs);
+        stats.write();
+        throw SimulationError(lines.front() + " (shot.on_integrity_failure: stop)");
+      }
+    }
     if (frame >= shot.frame_start) {
       write_frame_outputs(scene, solver, frame);
       stats.add(fs);

@@ -19,6 +19,8 @@ struct RunOptions {
   std::function<void(int, int, double, double, std::size_t)> on_substep;
   /// After each frame is simulated and written.
   std::function<void(const FrameStats&)> on_frame;
+  /// Warnings (integrity failures); printed even with --quiet.
+  std::function<void(const std::string&)> warn;
   /// Informational messages.
   std::function<void(const std::string&)> log;
 };

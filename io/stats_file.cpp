@@ -34,6 +34,35 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     j["contact_energy"] = s.contact_energy;
     j["friction_work"] = s.friction_work;
   }
+  if (s.integrity.active) {
+    const IntegrityReport& r = s.integrity;
+    nlohmann::json in;
+    in["checks"] = r.checks;
+    in["bulk_crossings"] = r.bulk_crossings;
+    in["shell_point_crossings"] = r.shell_point_crossings;
+    in["shell_crossing_edges"] = r.shell_crossing_edges;
+    in["self_crossing_edges"] = r.self_crossing_edges;
+    in["collider_penetrations"] = r.collider_penetrations;
+    in["max_collider_depth"] = r.max_collider_depth;
+    in["collider_depth_limit"] = r.collider_limit;
+    in["non_finite"] = r.non_finite;
+    nlohmann::json ev = nlohmann::json::array();
+    for (const IntegrityEvent& e : r.events) {
+      static const char* kinds[] = {"bulk_through_shell", "shell_through_shell", "shells_intersect",
+                                    "self_intersect",     "inside_collider",     "non_finite"};
+      nlohmann::json je;
+      je["kind"] = kinds[static_cast<int>(e.kind)];
+      je["object"] = e.object;
+      if (!e.other.empty()) je["other"] = e.other;
+      je["count"] = e.count;
+      if (e.kind == IntegrityEvent::Kind::InsideCollider) je["depth"] = e.value;
+      je["where"] = {e.where.x(), e.where.y(), e.where.z()};
+      ev.push_back(je);
+    }
+    in["events"] = ev;
+    in["ok"] = !r.failed();
+    j["integrity"] = in;
+  }
   nlohmann::json wall = nlohmann::json::object();
   for (const auto& [name, sec] : s.stage_seconds) wall[name] = sec;
   wall["total"] = s.wall_seconds;

@@ -30,6 +30,9 @@ struct ShotSettings {
   /// as in the paper); false: each keeps its own (ShellFields), friction from contact only.
   bool shared_shell_velocity = false;
   std::string units = "m";        ///< informational, written to VDB metadata
+  /// What a frame whose integrity check failed (material through a shell, shells crossing,
+  /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
+  enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;
 };
 
 enum class MaterialKind { Elastic, Sand, Snow };

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "sim/core/types.h"
+#include "sim/integrity/integrity_report.h"
 
 namespace shellmpm {
 
@@ -34,6 +35,8 @@ struct FrameStats {
   std::size_t contact_sliding = 0;     ///< sliding in the frame's last step
   double contact_energy = 0;           ///< sum V psi [J]
   double friction_work = 0;            ///< dissipated by sliding friction since the start [J]
+  /// What the integrity monitor found (crossings, collider penetration, non-finite).
+  IntegrityReport integrity;
   /// Wall-clock seconds per stage, in stage order (not deterministic, unlike the rest).
   std::vector<std::pair<std::string, double>> stage_seconds;
   double wall_seconds = 0;

@@ -59,6 +59,7 @@ Solver::Solver(const Scene& scene, SolverOptions opt) : scene_(scene), opt_(opt)
   }
   shell_forces_.resize(shells_.size());
   setup_contact();
+  integrity_.setup(integrity_view(), s.dx);
   if (opt_.fill_sources) {
     for (std::size_t i = 0; i < samplers_.size(); ++i) {
       if (scene_.sources[i].emit) continue;
@@ -360,7 +361,20 @@ void Solver::clamp_to_domain() {
   }
 }
 
-double Solver::stable_dt() const {
+IntegrityView Solver::integrity_view() const {
+  IntegrityView v;
+  v.bulk = &particles_;
+  for (const GridShell& g : grid_shells_) v.shells.push_back(g.shell);
+  v.colliders = &colliders_;
+  v.serial = opt_.serial;
+  return v;
+}
+
+IntegrityReport Solver::integrity_snapshot() { return integrity_.snapshot(integrity_view()); }
+
+double Solver::stable_dt() const { return stable_dt(nullptr); }
+
+double Solver::stable_dt(double* vmax_out) const {
   const ShotSettings& s = scene_.shot;
   double dt = std::min(s.dt_max, shell_dt_);
   const std::size_t n = particles_.size();
@@ -402,6 +416,7 @@ double Solver::stable_dt() const {
       vmax = std::max(vmax, sp);
     }
   for (const Collider& c : colliders_) vmax = std::max(vmax, c.max_speed(time_));
+  if (vmax_out) *vmax_out = vmax;
   if (vmax > 0) dt = std::min(dt, s.cfl * s.dx / vmax);
   if (cmax > 0) dt = std::min(dt, s.cfl * s.dx / cmax);
   return dt;
@@ -413,10 +428,18 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   for (Stage& st : stages_) st.seconds = 0;
   FrameStats fs;
   fs.dt_min = 1e300;
-  double dt_seconds = 0;
+  double dt_seconds = 0, integrity_seconds = 0;
+  const auto i0 = clock::now();
+  const IntegrityView view = integrity_view();
+  integrity_.begin_frame(view);
+  integrity_seconds += std::chrono::duration<double>(clock::now() - i0).count();
+  // Relative motion since the last integrity side check, bounded by twice the largest
+  // speed times the time elapsed: a check whenever it could reach dx (integrity_monitor.h).
+  double moved = 0;
   while (time_ < t_end) {
     const auto d0 = clock::now();
-    double dt = stable_dt();
+    double vmax = 0;
+    double dt = stable_dt(&vmax);
     const double remaining = t_end - time_;
     if (!std::isfinite(dt)) {
       std::ostringstream os;
@@ -444,7 +467,19 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
     fs.substeps++;
     fs.dt_min = std::min(fs.dt_min, dt);
     fs.dt_max = std::max(fs.dt_max, dt);
+    moved += 2.0 * vmax * dt;
+    if (moved >= grid_.dx() && time_ < t_end) {
+      const auto c0 = clock::now();
+      integrity_.track(view);
+      integrity_seconds += std::chrono::duration<double>(clock::now() - c0).count();
+      moved = 0;
+    }
     if (cb) cb(fs.substeps, dt, time_);
+  }
+  {
+    const auto c0 = clock::now();
+    fs.integrity = integrity_.end_frame(view);
+    integrity_seconds += std::chrono::duration<double>(clock::now() - c0).count();
   }
   if (fs.substeps == 0) fs.dt_min = 0;
   // Reorder particles by grid block once per frame for memory locality.
@@ -460,6 +495,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   if (!stages_.empty()) {
     fs.stage_seconds.emplace_back("dt", dt_seconds);
     fs.stage_seconds.emplace_back("reorder", reorder_seconds);
+    if (integrity_.active()) fs.stage_seconds.emplace_back("integrity", integrity_seconds);
   }
   fs.wall_seconds = std::chrono::duration<double>(clock::now() - wall0).count();
   return fs;

@@ -11,6 +11,7 @@
 #include "sim/collider/collider.h"
 #include "sim/contact/shell_fields.h"
 #include "sim/contact/shell_transfer.h"
+#include "sim/integrity/integrity_monitor.h"
 #include "sim/mpm/constitutive.h"
 #include "sim/mpm/particles.h"
 #include "sim/mpm/sparse_grid.h"
@@ -47,6 +48,9 @@ class Solver {
   void measure(FrameStats& s) const;
   /// The step the solver would take now, before splitting the remaining frame time.
   double stable_dt() const;  // NaN when a velocity is not finite (diverged)
+  /// The integrity checks for the current state without advancing (frame 1); the frame
+  /// reports of advance_to carry the crossings seen while advancing.
+  IntegrityReport integrity_snapshot();
 
   double time() const { return time_; }
   void set_time(double t) { time_ = t; }
@@ -87,6 +91,9 @@ class Solver {
     double seconds = 0;
   };
   void build_stages();
+  /// stable_dt, and the largest particle, shell point or collider speed [m/s].
+  double stable_dt(double* vmax) const;
+  IntegrityView integrity_view() const;
   void add_particles_from(std::size_t source, const std::vector<Vec3d>& pts);
   void step(double dt);
   void grid_update();
@@ -119,6 +126,7 @@ class Solver {
   ShellPointTable shell_table_;
   std::vector<Vec3> shell_points_;  ///< binned positions of the grid shells' points
   ContactStepStats contact_step_;   ///< the last step's return mapping
+  IntegrityMonitor integrity_;
   double friction_work_ = 0;
   double shell_dt_ = 1e300;
   double plastic_work_ = 0;

@@ -1,0 +1,397 @@
+#include "sim/integrity/integrity_monitor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "sim/core/parallel.h"
+
+namespace shellmpm {
+namespace {
+
+constexpr std::size_t kGrain = 2048;
+constexpr double kRimCells = 2.0;    ///< points this close to a boundary (rest) are not judged
+constexpr double kDeadCells = 1e-3;  ///< points this close to the surface have no side
+constexpr double kColliderCells = 0.5;
+
+// Per-chunk tallies, combined in chunk order (deterministic).
+struct Tally {
+  std::vector<std::size_t> count;
+  std::vector<Vec3d> where;
+  std::vector<int> from;
+  explicit Tally(std::size_t k = 0) : count(k, 0), where(k, Vec3d::Zero()), from(k, -1) {}
+  void add(int s, const Vec3d& x, int src) {
+    if (count[s]++ == 0) {
+      where[s] = x;
+      from[s] = src;
+    }
+  }
+};
+
+void merge(const std::vector<Tally>& parts, std::vector<std::size_t>& count, std::vector<Vec3d>& where,
+           std::vector<int>* from) {
+  for (const Tally& t : parts)
+    for (std::size_t s = 0; s < count.size(); ++s) {
+      if (t.count[s] == 0) continue;
+      if (count[s] == 0) {
+        where[s] = t.where[s];
+        if (from) (*from)[s] = t.from[s];
+      }
+      count[s] += t.count[s];
+    }
+}
+
+}  // namespace
+
+void IntegrityMonitor::setup(const IntegrityView& view, double dx) {
+  dx_ = dx;
+  band_ = 2.0 * dx;
+  shells_.clear();
+  names_.clear();
+  vertex_offset_.assign(1, 0);
+  for (const ShellObject* sh : view.shells) {
+    ShellGeom g;
+    g.limit = std::make_unique<LimitMesh>(sh->basis(), sh->triangles(), std::vector<Eigen::Vector2d>{}, 0);
+    const auto& T = g.limit->triangles();
+    std::map<std::pair<int, int>, int> uses;
+    for (const Eigen::Vector3i& t : T)
+      for (int e = 0; e < 3; ++e) {
+        const int a = std::min(t[e], t[(e + 1) % 3]), b = std::max(t[e], t[(e + 1) % 3]);
+        ++uses[{a, b}];
+      }
+    std::vector<Vec3> rest_x(sh->rest.size());
+    for (std::size_t i = 0; i < rest_x.size(); ++i) rest_x[i] = sh->rest[i].cast<Real>();
+    std::vector<Vec3> rp, rn;
+    g.limit->evaluate(rest_x.data(), rp, rn);
+    std::vector<int> boundary;
+    for (const auto& [e, n] : uses) {
+      g.edges.push_back(e);
+      if (n == 1) {
+        boundary.push_back(e.first);
+        boundary.push_back(e.second);
+      }
+    }
+    std::sort(boundary.begin(), boundary.end());
+    boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
+    g.rim.assign(rp.size(), std::numeric_limits<double>::infinity());
+    for (std::size_t v = 0; v < rp.size(); ++v)
+      for (int b : boundary)
+        g.rim[v] = std::min(g.rim[v], (rp[v] - rp[b]).cast<double>().norm());
+    vertex_offset_.push_back(vertex_offset_.back() + rp.size());
+    shells_.push_back(std::move(g));
+    names_.push_back(sh->name());
+  }
+  const bool colliders = view.colliders && !view.colliders->empty();
+  active_ = !shells_.empty() || colliders;
+  bulk_cross_.assign(shells_.size(), 0);
+  point_cross_.assign(shells_.size(), 0);
+}
+
+void IntegrityMonitor::refresh(const IntegrityView& view) {
+  std::vector<Vec3> p, n;
+  for (std::size_t s = 0; s < shells_.size(); ++s) {
+    ShellGeom& g = shells_[s];
+    g.limit->evaluate(view.shells[s]->x.data(), p, n);
+    g.pos.resize(p.size());
+    g.nrm.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      g.pos[i] = p[i].cast<double>();
+      g.nrm[i] = n[i].cast<double>();
+    }
+    g.grid.build(g.pos, g.limit->triangles(), 2.0 * band_, band_);
+  }
+}
+
+IntegrityMonitor::Hit IntegrityMonitor::side_of(const Vec3d& x, int exclude) const {
+  thread_local std::vector<int> cand;
+  Hit best;
+  double best_d2 = band_ * band_;
+  Vec3d best_c = Vec3d::Zero(), best_b = Vec3d::Zero();
+  int best_t = -1;
+  for (std::size_t s = 0; s < shells_.size(); ++s) {
+    if (static_cast<int>(s) == exclude) continue;
+    const ShellGeom& g = shells_[s];
+    g.grid.query(x, cand);
+    const auto& T = g.limit->triangles();
+    for (int t : cand) {
+      const Vec3d& a = g.pos[T[t][0]];
+      const Vec3d& b = g.pos[T[t][1]];
+      const Vec3d& c = g.pos[T[t][2]];
+      const Vec3d bc = closest_point_barycentric(x, a, b, c);
+      const Vec3d cp = bc[0] * a + bc[1] * b + bc[2] * c;
+      const double d2 = (x - cp).squaredNorm();
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best.shell = static_cast<int>(s);
+        best_c = cp;
+        best_b = bc;
+        best_t = t;
+      }
+    }
+  }
+  if (best.shell < 0) return best;  // Far
+  const ShellGeom& g = shells_[best.shell];
+  const Eigen::Vector3i& tri = g.limit->triangles()[best_t];
+  const double rim = best_b[0] * g.rim[tri[0]] + best_b[1] * g.rim[tri[1]] + best_b[2] * g.rim[tri[2]];
+  if (rim < kRimCells * dx_) {
+    best.side = Side::Rim;
+    return best;
+  }
+  Vec3d n = best_b[0] * g.nrm[tri[0]] + best_b[1] * g.nrm[tri[1]] + best_b[2] * g.nrm[tri[2]];
+  const double sd = (x - best_c).dot(n.normalized());
+  best.side = std::abs(sd) < kDeadCells * dx_ ? Side::Dead : sd > 0 ? Side::Plus : Side::Minus;
+  return best;
+}
+
+void IntegrityMonitor::compare(const IntegrityView& view, bool record_only) {
+  refresh(view);
+  const std::size_t nv = vertex_offset_.back();
+  const std::size_t nb = view.bulk ? view.bulk->size() : 0;
+  const std::size_t n = nv + nb;
+  if (record_only) {
+    rec_shell_.assign(n, -1);
+    rec_side_.assign(n, 0);
+  } else {
+    rec_shell_.resize(n, -1);  // particles emitted since the last check
+    rec_side_.resize(n, 0);
+  }
+  if (shells_.empty()) return;
+  ++checks_;
+  const std::size_t K = shells_.size();
+  const std::size_t chunks = (n + kGrain - 1) / kGrain;
+  std::vector<Tally> bulk(chunks, Tally(K)), pts(chunks, Tally(K));
+  parallel_for(
+      n, kGrain,
+      [&](std::size_t b, std::size_t e) {
+        Tally& tb = bulk[b / kGrain];
+        Tally& tp = pts[b / kGrain];
+        std::size_t s = 0;
+        for (std::size_t i = b; i < e; ++i) {
+          Vec3d x;
+          int own = -1;
+          if (i < nv) {
+            while (vertex_offset_[s + 1] <= i) ++s;
+            own = static_cast<int>(s);
+            x = shells_[s].pos[i - vertex_offset_[s]];
+          } else {
+            x = view.bulk->x[i - nv].cast<double>();
+          }
+          const Hit h = side_of(x, own);
+          if (h.side == Side::Far || h.side == Side::Rim) {
+            rec_shell_[i] = -1;
+            continue;
+          }
+          if (h.side == Side::Dead) continue;
+          const auto side = static_cast<std::int8_t>(h.side);
+          if (!record_only && rec_shell_[i] == h.shell && rec_side_[i] == -side) {
+            if (own < 0)
+              tb.add(h.shell, x, -1);
+            else
+              tp.add(h.shell, x, own);
+          }
+          rec_shell_[i] = static_cast<std::int16_t>(h.shell);
+          rec_side_[i] = side;
+        }
+      },
+      view.serial);
+  merge(bulk, bulk_cross_, bulk_where_, nullptr);
+  merge(pts, point_cross_, point_where_, &point_from_);
+}
+
+void IntegrityMonitor::begin_frame(const IntegrityView& view) {
+  const std::size_t K = shells_.size();
+  bulk_cross_.assign(K, 0);
+  point_cross_.assign(K, 0);
+  bulk_where_.assign(K, Vec3d::Zero());
+  point_where_.assign(K, Vec3d::Zero());
+  point_from_.assign(K, -1);
+  checks_ = 0;
+  if (!active_) return;
+  compare(view, true);
+  checks_ = 0;
+}
+
+void IntegrityMonitor::track(const IntegrityView& view) {
+  if (active_) compare(view, false);
+}
+
+IntegrityReport IntegrityMonitor::end_frame(const IntegrityView& view) {
+  IntegrityReport r;
+  if (!active_) return r;
+  compare(view, false);
+  r.checks = checks_;
+  for (std::size_t s = 0; s < shells_.size(); ++s) {
+    if (bulk_cross_[s]) {
+      IntegrityEvent e;
+      e.kind = IntegrityEvent::Kind::BulkThroughShell;
+      e.object = names_[s];
+      e.count = bulk_cross_[s];
+      e.where = bulk_where_[s];
+      r.events.push_back(e);
+      r.bulk_crossings += bulk_cross_[s];
+    }
+    if (point_cross_[s]) {
+      IntegrityEvent e;
+      e.kind = IntegrityEvent::Kind::ShellThroughShell;
+      e.object = names_[s];
+      e.other = point_from_[s] >= 0 ? names_[point_from_[s]] : "";
+      e.count = point_cross_[s];
+      e.where = point_where_[s];
+      r.events.push_back(e);
+      r.shell_point_crossings += point_cross_[s];
+    }
+  }
+  frame_end_checks(view, r);
+  return r;
+}
+
+IntegrityReport IntegrityMonitor::snapshot(const IntegrityView& view) {
+  IntegrityReport r;
+  if (!active_) return r;
+  refresh(view);
+  frame_end_checks(view, r);
+  return r;
+}
+
+void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityReport& r) const {
+  r.active = true;
+  r.collider_limit = kColliderCells * dx_;
+  const std::size_t nb = view.bulk ? view.bulk->size() : 0;
+  // Non-finite state.
+  {
+    std::size_t bad = 0;
+    for (std::size_t p = 0; p < nb; ++p)
+      bad += !(view.bulk->x[p].allFinite() && view.bulk->v[p].allFinite());
+    if (bad) {
+      IntegrityEvent e;
+      e.kind = IntegrityEvent::Kind::NonFinite;
+      e.object = "bulk particles";
+      e.count = bad;
+      r.events.push_back(e);
+      r.non_finite += bad;
+    }
+    for (std::size_t s = 0; s < shells_.size(); ++s) {
+      const ShellObject& sh = *view.shells[s];
+      std::size_t b = 0;
+      for (std::size_t j = 0; j < sh.size(); ++j) b += !(sh.x[j].allFinite() && sh.v[j].allFinite());
+      if (!b) continue;
+      IntegrityEvent e;
+      e.kind = IntegrityEvent::Kind::NonFinite;
+      e.object = names_[s];
+      e.count = b;
+      r.events.push_back(e);
+      r.non_finite += b;
+    }
+  }
+  // Edges through triangles: every ordered pair of shells, self included.
+  const std::size_t K = shells_.size();
+  for (std::size_t a = 0; a < K; ++a)
+    for (std::size_t b = a; b < K; ++b) {
+      std::size_t count = 0;
+      Vec3d where = Vec3d::Zero();
+      for (int dir = 0; dir < (a == b ? 1 : 2); ++dir) {
+        const ShellGeom& ea = shells_[dir ? b : a];
+        const ShellGeom& tb = shells_[dir ? a : b];
+        const bool self = a == b;
+        const auto& T = tb.limit->triangles();
+        const std::size_t ne = ea.edges.size();
+        const std::size_t chunks = (ne + kGrain - 1) / kGrain;
+        std::vector<Tally> parts(chunks, Tally(1));
+        parallel_for(
+            ne, kGrain,
+            [&](std::size_t eb, std::size_t ee) {
+              std::vector<int> cand;
+              Tally& tl = parts[eb / kGrain];
+              for (std::size_t i = eb; i < ee; ++i) {
+                const auto [u, v] = ea.edges[i];
+                const Vec3d& p = ea.pos[u];
+                const Vec3d& q = ea.pos[v];
+                tb.grid.query_box(p.cwiseMin(q), p.cwiseMax(q), cand);
+                for (int t : cand) {
+                  const Eigen::Vector3i& tri = T[t];
+                  if (self && (tri[0] == u || tri[1] == u || tri[2] == u || tri[0] == v ||
+                               tri[1] == v || tri[2] == v))
+                    continue;
+                  if (segment_crosses_triangle(p, q, tb.pos[tri[0]], tb.pos[tri[1]], tb.pos[tri[2]])) {
+                    tl.add(0, 0.5 * (p + q), -1);
+                    break;
+                  }
+                }
+              }
+            },
+            view.serial);
+        for (const Tally& t : parts) {
+          if (t.count[0] && count == 0) where = t.where[0];
+          count += t.count[0];
+        }
+      }
+      if (!count) continue;
+      IntegrityEvent e;
+      e.kind = a == b ? IntegrityEvent::Kind::SelfIntersect : IntegrityEvent::Kind::ShellsIntersect;
+      e.object = names_[a];
+      e.other = a == b ? "" : names_[b];
+      e.count = count;
+      e.where = where;
+      r.events.push_back(e);
+      (a == b ? r.self_crossing_edges : r.shell_crossing_edges) += count;
+    }
+  // Colliders: bulk particles and shell limit vertices deeper than the limit.
+  if (view.colliders)
+    for (const Collider& c : *view.colliders) {
+      struct Deep {
+        std::size_t count = 0;
+        double depth = 0;
+        Vec3d where = Vec3d::Zero();
+      };
+      const std::size_t nv = vertex_offset_.back();
+      const std::size_t n = nv + nb;
+      const std::size_t chunks = (n + kGrain - 1) / kGrain;
+      std::vector<Deep> parts(chunks);
+      parallel_for(
+          n, kGrain,
+          [&](std::size_t b, std::size_t e) {
+            Deep& d = parts[b / kGrain];
+            std::size_t s = 0;
+            for (std::size_t i = b; i < e; ++i) {
+              Vec3d x;
+              if (i < nv) {
+                while (vertex_offset_[s + 1] <= i) ++s;
+                x = shells_[s].pos[i - vertex_offset_[s]];
+              } else {
+                x = view.bulk->x[i - nv].cast<double>();
+              }
+              Aabb at;
+              at.lo = at.hi = x;
+              if (!x.allFinite() || !c.bounds().overlaps(at)) continue;
+              const double depth = -c.phi(x);
+              if (depth > d.depth) {
+                d.depth = depth;
+                d.where = x;
+              }
+              if (depth > r.collider_limit) ++d.count;
+            }
+          },
+          view.serial);
+      Deep total;
+      for (const Deep& d : parts) {
+        total.count += d.count;
+        if (d.depth > total.depth) {
+          total.depth = d.depth;
+          total.where = d.where;
+        }
+      }
+      r.max_collider_depth = std::max(r.max_collider_depth, total.depth);
+      if (!total.count) continue;
+      IntegrityEvent e;
+      e.kind = IntegrityEvent::Kind::InsideCollider;
+      e.object = c.desc().name;
+      e.count = total.count;
+      e.value = total.depth;
+      e.where = total.where;
+      r.events.push_back(e);
+      r.collider_penetrations += total.count;
+    }
+}
+
+}  // namespace shellmpm

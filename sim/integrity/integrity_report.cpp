@@ -1,0 +1,48 @@
+#include "sim/integrity/integrity_report.h"
+
+#include <sstream>
+
+namespace shellmpm {
+
+std::vector<std::string> describe_integrity(const IntegrityReport& r, int frame, double dx) {
+  std::vector<std::string> out;
+  for (const IntegrityEvent& e : r.events) {
+    std::ostringstream os;
+    os.precision(3);
+    os << "frame " << frame << ": ";
+    const auto at = [&] {
+      os << " (at " << e.where.x() << ", " << e.where.y() << ", " << e.where.z() << ")";
+    };
+    switch (e.kind) {
+      case IntegrityEvent::Kind::BulkThroughShell:
+        os << e.count << " bulk particles crossed shell '" << e.object << "'";
+        at();
+        break;
+      case IntegrityEvent::Kind::ShellThroughShell:
+        os << e.count << " points of shell '" << e.other << "' crossed shell '" << e.object << "'";
+        at();
+        break;
+      case IntegrityEvent::Kind::ShellsIntersect:
+        os << "shells '" << e.object << "' and '" << e.other << "' pass through each other ("
+           << e.count << " crossing edges)";
+        at();
+        break;
+      case IntegrityEvent::Kind::SelfIntersect:
+        os << "shell '" << e.object << "' passes through itself (" << e.count << " crossing edges)";
+        at();
+        break;
+      case IntegrityEvent::Kind::InsideCollider:
+        os << e.count << " points are more than " << 0.5 << " dx inside collider '" << e.object
+           << "' (deepest " << e.value / dx << " dx";
+        os << ", at " << e.where.x() << ", " << e.where.y() << ", " << e.where.z() << ")";
+        break;
+      case IntegrityEvent::Kind::NonFinite:
+        os << e.count << " non-finite positions or velocities in " << e.object;
+        break;
+    }
+    out.push_back(os.str());
+  }
+  return out;
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,118 @@
+#include "sim/integrity/triangle_queries.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace shellmpm {
+
+Vec3d closest_point_barycentric(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
+  const Vec3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return {1 - v, v, 0};
+  }
+  const Vec3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double w = d2 / (d2 - d6);
+    return {1 - w, 0, w};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0, 1 - w, w};
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  if (!std::isfinite(denom)) return {1, 0, 0};  // degenerate triangle
+  const double v = vb * denom, w = vc * denom;
+  return {1 - v - w, v, w};
+}
+
+bool segment_crosses_triangle(const Vec3d& p, const Vec3d& q, const Vec3d& a, const Vec3d& b,
+                              const Vec3d& c) {
+  const Vec3d d = q - p, e1 = b - a, e2 = c - a;
+  const Vec3d h = d.cross(e2);
+  const double det = e1.dot(h);
+  const double scale = e1.norm() * e2.norm() * d.norm();
+  if (!(std::abs(det) > 1e-12 * scale)) return false;  // parallel (or degenerate)
+  const double inv = 1.0 / det;
+  const Vec3d s = p - a;
+  const double u = inv * s.dot(h);
+  if (u < 0 || u > 1) return false;
+  const Vec3d qv = s.cross(e1);
+  const double v = inv * d.dot(qv);
+  if (v < 0 || u + v > 1) return false;
+  const double t = inv * e2.dot(qv);
+  return t >= 0 && t <= 1;
+}
+
+std::uint64_t TriangleGrid::key(const Vec3i& c) const {
+  // 21 bits per axis, offset so negative cells stay distinct.
+  const auto u = [](int v) { return static_cast<std::uint64_t>(v + (1 << 20)) & 0x1fffff; };
+  return (u(c[0]) << 42) | (u(c[1]) << 21) | u(c[2]);
+}
+
+Vec3i TriangleGrid::cell_of(const Vec3d& p) const {
+  Vec3i c;
+  for (int a = 0; a < 3; ++a) c[a] = static_cast<int>(std::floor(p[a] * inv_cell_));
+  return c;
+}
+
+void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen::Vector3i>& tris,
+                         double cell, double pad) {
+  inv_cell_ = 1.0 / cell;
+  std::vector<std::pair<std::uint64_t, int>> pairs;
+  pairs.reserve(tris.size() * 4);
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    Vec3d lo = pos[tris[t][0]], hi = lo;
+    for (int k = 1; k < 3; ++k) {
+      lo = lo.cwiseMin(pos[tris[t][k]]);
+      hi = hi.cwiseMax(pos[tris[t][k]]);
+    }
+    if (!lo.allFinite() || !hi.allFinite()) continue;
+    const Vec3i c0 = cell_of(lo.array() - pad), c1 = cell_of(hi.array() + pad);
+    for (int i = c0[0]; i <= c1[0]; ++i)
+      for (int j = c0[1]; j <= c1[1]; ++j)
+        for (int k = c0[2]; k <= c1[2]; ++k) pairs.emplace_back(key(Vec3i(i, j, k)), static_cast<int>(t));
+  }
+  std::sort(pairs.begin(), pairs.end());
+  keys_.resize(pairs.size());
+  tri_.resize(pairs.size());
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    keys_[i] = pairs[i].first;
+    tri_[i] = pairs[i].second;
+  }
+}
+
+void TriangleGrid::query(const Vec3d& p, std::vector<int>& out) const {
+  out.clear();
+  if (!p.allFinite()) return;
+  const std::uint64_t k = key(cell_of(p));
+  const auto r = std::equal_range(keys_.begin(), keys_.end(), k);
+  for (auto it = r.first; it != r.second; ++it) out.push_back(tri_[it - keys_.begin()]);
+}
+
+void TriangleGrid::query_box(const Vec3d& lo, const Vec3d& hi, std::vector<int>& out) const {
+  out.clear();
+  if (!lo.allFinite() || !hi.allFinite()) return;
+  const Vec3i c0 = cell_of(lo), c1 = cell_of(hi);
+  for (int i = c0[0]; i <= c1[0]; ++i)
+    for (int j = c0[1]; j <= c1[1]; ++j)
+      for (int k = c0[2]; k <= c1[2]; ++k) {
+        const auto r = std::equal_range(keys_.begin(), keys_.end(), key(Vec3i(i, j, k)));
+        for (auto it = r.first; it != r.second; ++it) out.push_back(tri_[it - keys_.begin()]);
+      }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+}  // namespace shellmpm
