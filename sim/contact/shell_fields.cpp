@@ -85,11 +85,14 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
                   const Real side = nj.dot(Vec3(Real(i), Real(jj), Real(k)) - fx);
                   const Real wn = side > 0 ? w * m : side < 0 ? -w * m : Real(0);
                   Node& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
+                  const Vec3 off = fx - Vec3(Real(i), Real(jj), Real(k));
                   nd.m += w * m;
                   nd.held += w * mh;
                   for (int a = 0; a < 3; ++a) {
                     nd.p[a] += mom[a];
                     nd.n[a] += wn * nj[a];
+                    nd.N[a] += w * m * nj[a];
+                    nd.o[a] += w * m * off[a];
                   }
                 }
           }
@@ -111,18 +114,88 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
             for (int a = 0; a < 3; ++a) {
               d.p[a] += from.p[a];
               d.n[a] += from.n[a];
+              d.N[a] += from.N[a];
+              d.o[a] += from.o[a];
             }
           });
           for (Node& d : nodes)
             if (d.m > 0)
-              for (Real& p : d.p) p /= d.m;
+              for (int a = 0; a < 3; ++a) {
+                d.p[a] /= d.m;
+                d.o[a] /= d.m;
+              }
+        }
+      },
+      serial);
+}
+
+void ShellFields::bulk_moments(const SparseGrid& combined, const ParticleSet& bulk,
+                               std::uint32_t first_bulk, bool serial) {
+  const std::size_t nb = combined.num_particle_blocks(), ng = combined.num_grid_blocks();
+  bulk_buf_.resize(nb);
+  bulk_mom_.resize(ng);
+  std::vector<char> touch(nb, 0);
+  for (std::size_t b = 0; b < nb; ++b)
+    for (int o = 0; o < 8; ++o) {
+      const int g = combined.pblock_nbr[b][o];
+      if (g >= 0 && fielded_[g]) touch[b] = 1;
+    }
+  parallel_for(
+      nb, 1,
+      [&](std::size_t bb, std::size_t be) {
+        for (std::size_t b = bb; b < be; ++b) {
+          if (!touch[b]) continue;
+          auto& buf = bulk_buf_[b];
+          std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
+          const Vec3i bc = unpack_block(combined.pblock_key[b]) * kBlockSize;
+          const auto* o = combined.order.data();
+          const std::uint32_t s1 = combined.pblock_start[b + 1];
+          // Bulk particles follow the shell points in each block's sorted slice.
+          const std::uint32_t s0 = static_cast<std::uint32_t>(
+              std::lower_bound(o + combined.pblock_start[b], o + s1, first_bulk) - o);
+          for (std::uint32_t q = s0; q < s1; ++q) {
+            const std::uint32_t p = o[q] - first_bulk;
+            const QuadraticWeights W(combined.grid_coord(bulk.x[p]));
+            const Real m = bulk.volume[p];  // volume-weighted: the densities cancel in a centroid
+            const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+            for (int i = 0; i < 3; ++i)
+              for (int j = 0; j < 3; ++j)
+                for (int k = 0; k < 3; ++k) {
+                  const Real w = W.w[0][i] * W.w[1][j] * W.w[2][k] * m;
+                  Moment& nd = buf[pad_node(lx + i, ly + j, lz + k)];
+                  nd.m += w;
+                  nd.o[0] += w * (W.fx[0] - Real(i));
+                  nd.o[1] += w * (W.fx[1] - Real(j));
+                  nd.o[2] += w * (W.fx[2] - Real(k));
+                }
+          }
+        }
+      },
+      serial);
+  parallel_for(
+      ng, 4,
+      [&](std::size_t gb, std::size_t ge) {
+        for (std::size_t g = gb; g < ge; ++g) {
+          if (!fielded_[g]) continue;
+          auto& nodes = bulk_mom_[g];
+          std::memset(static_cast<void*>(nodes.data()), 0, sizeof(nodes));
+          combined.for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
+            if (!touch[src]) return;
+            const Moment& from = bulk_buf_[src][sn];
+            Moment& d = nodes[dn];
+            d.m += from.m;
+            for (int a = 0; a < 3; ++a) d.o[a] += from.o[a];
+          });
+          for (Moment& d : nodes)
+            if (d.m > 0)
+              for (Real& x : d.o) x /= d.m;
         }
       },
       serial);
 }
 
 void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& shells, Real dt,
-                      bool serial) {
+                      const ParticleSet* bulk_particles, std::uint32_t first_bulk, bool serial) {
   const std::size_t K = fields_.size();
   friction_.resize(K);
   for (std::size_t s = 0; s < K; ++s) {
@@ -131,22 +204,32 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   }
   const std::size_t ng = combined.num_grid_blocks();
   fblock_.assign(ng * K, -1);
+  fielded_.assign(ng, 0);
   r_bulk_.resize(ng);
   shared_.assign(ng, 0);
+  parallel_for(
+      ng, 16,
+      [&](std::size_t gb, std::size_t ge) {
+        for (std::size_t g = gb; g < ge; ++g) {
+          int* fb = fblock_.data() + g * K;
+          for (std::size_t s = 0; s < K; ++s) {
+            fb[s] = fields_[s].grid.find_grid_block(combined.gblock_key[g]);
+            if (fb[s] >= 0) fielded_[g] = 1;
+          }
+        }
+      },
+      serial);
+  const bool moments = bulk_particles && bulk_particles->size() > 0;
+  if (moments) bulk_moments(combined, *bulk_particles, first_bulk, serial);
   parallel_for(
       ng, 4,
       [&](std::size_t gb, std::size_t ge) {
         std::vector<int> ids;
-        std::vector<Vec3> vel(K), nrm(K);
+        std::vector<Vec3> vel(K), nrm(K), own(K), off(K);
         std::vector<Real> winv(K);
         for (std::size_t g = gb; g < ge; ++g) {
-          int* fb = fblock_.data() + g * K;
-          int present = 0;
-          for (std::size_t s = 0; s < K; ++s) {
-            fb[s] = fields_[s].grid.find_grid_block(combined.gblock_key[g]);
-            if (fb[s] >= 0) ++present;
-          }
-          if (present == 0) continue;
+          if (!fielded_[g]) continue;
+          const int* fb = fblock_.data() + g * K;
           r_bulk_[g].fill(Vec3::Zero());
           for (int n = 0; n < kBlockNodes; ++n) {
             const GridNode& cn = combined.gblock_nodes[g][n];
@@ -169,18 +252,20 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
             const Vec3 p(cn.v[0], cn.v[1], cn.v[2]);
             const Vec3 v0 = p / cn.m;
             Vec3 vk = bulk ? Vec3((p - ps) / mk) : Vec3::Zero();
-            // The shells here: velocity, normal towards the node, inverse effective mass
-            // (the pinned share infinitely heavy: m^2 / free).
+            // The shells here: velocity, normal towards the node, own normal and centroid
+            // offset, inverse effective mass (the pinned share infinitely heavy: m^2 / free).
             ids.clear();
             for (std::size_t s = 0; s < K; ++s) {
               if (fb[s] < 0) continue;
               const Node& f = fields_[s].nodes[fb[s]][n];
               if (f.m <= 0) continue;
-              const Vec3 ns(f.n[0], f.n[1], f.n[2]);
-              const Real nl = ns.norm();
+              const Vec3 ns(f.n[0], f.n[1], f.n[2]), Ns(f.N[0], f.N[1], f.N[2]);
+              const Real nl = ns.norm(), Nl = Ns.norm();
               ids.push_back(static_cast<int>(s));
               vel[s] = Vec3(f.p[0], f.p[1], f.p[2]);
               nrm[s] = nl > 0 ? Vec3(ns / nl) : Vec3::Zero();
+              own[s] = Nl > 0 ? Vec3(Ns / Nl) : Vec3::Zero();
+              off[s] = Vec3(f.o[0], f.o[1], f.o[2]);
               winv[s] = std::max(f.m - f.held, Real(0)) / (f.m * f.m);
             }
             // Shell against shell (on opposite sides of the node), then each shell against
@@ -193,10 +278,34 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
                 contact_pair(d / d.norm(), std::sqrt(friction_[a] * friction_[b]), winv[a], vel[a],
                              winv[b], vel[b]);
               }
-            if (bulk)
-              for (int a : ids)
-                if (nrm[a].squaredNorm() > 0)
-                  contact_pair(nrm[a], friction_[a], winv[a], vel[a], Real(1) / mk, vk);
+            if (bulk) {
+              // Which side of a shell the bulk material is on: where its mass centroid lies
+              // along the shell's own normal (Nairn's multi-material contact takes the
+              // normal from the mass distribution the same way). The node's side is not
+              // enough: the kernel spreads a body's mass 1.5 dx past its particles, so a
+              // heavy block on a light film also has mass at nodes under the film, where
+              // "the node's side" reads its approach as separation and lets it through.
+              // The node's side stays the fallback where the bulk centroid lies on the
+              // shell (within 0.05 dx: bulk on both sides).
+              Vec3 ok = Vec3::Zero();
+              bool have_ok = false;
+              if (moments) {
+                const Moment& bm = bulk_mom_[g][n];
+                if (bm.m > 0) {
+                  ok = Vec3(bm.o[0], bm.o[1], bm.o[2]);
+                  have_ok = true;
+                }
+              }
+              for (int a : ids) {
+                Vec3 nb = nrm[a];
+                if (have_ok && own[a].squaredNorm() > 0) {
+                  const Real d = own[a].dot(ok - off[a]);
+                  if (std::abs(d) > Real(0.05)) nb = d > 0 ? own[a] : Vec3(-own[a]);
+                }
+                if (nb.squaredNorm() > 0)
+                  contact_pair(nb, friction_[a], winv[a], vel[a], Real(1) / mk, vk);
+              }
+            }
             for (int a : ids) fields_[a].r[fb[a]][n] = vel[a] - v0;
             if (bulk) r_bulk_[g][n] = vk - v0;
             shared_[g] |= std::uint64_t(1) << n;

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "sim/contact/shell_transfer.h"
+#include "sim/mpm/particles.h"
 #include "sim/mpm/sparse_grid.h"
 
 namespace shellmpm {
@@ -51,8 +52,9 @@ class ShellFields {
   /// Right after the combined P2G (the combined grid holds mass and momentum): each
   /// shell's own P2G, and the relative velocities v_b^0 - v^0 of every body at the nodes
   /// two bodies share.
+  /// bulk: the bulk particles, binned in `combined` as first_bulk + index (null: none).
   void p2g(const SparseGrid& combined, const std::vector<GridShell>& shells, Real dt,
-           bool serial);
+           const ParticleSet* bulk, std::uint32_t first_bulk, bool serial);
   /// After the grid update, before G2P: drops the relative velocities where skip() says
   /// so, and gives shared nodes the bulk field's velocity (bulk particles, contact
   /// particles and the shells' plain G2P then read it).
@@ -67,7 +69,14 @@ class ShellFields {
     Real m;
     Real p[3];  ///< momentum; velocity after p2g()
     Real n[3];  ///< sum of w m n_j, n_j the shell normal turned to the node's side
+    Real N[3];  ///< sum of w m n_j, n_j the shell's own (oriented) normal
+    Real o[3];  ///< sum of w m (x_j - x_node) / dx; the centroid offset after p2g()
     Real held;  ///< mass of fully pinned control points
+  };
+  /// Bulk mass and first moment sum w m (x_p - x_node) / dx at a node.
+  struct Moment {
+    Real m;
+    Real o[3];
   };
   struct Field {
     SparseGrid grid;  ///< binning of this shell's control points (its nodes unused)
@@ -78,6 +87,9 @@ class ShellFields {
     std::vector<Vec3> normal;                      ///< control-point unit normals
   };
   void shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial);
+  /// Bulk mass centroids on the grid blocks where shells have fields.
+  void bulk_moments(const SparseGrid& combined, const ParticleSet& bulk, std::uint32_t first_bulk,
+                    bool serial);
   static void contact_pair(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb);
   bool active_ = false;
   std::vector<Field> fields_;
@@ -86,6 +98,9 @@ class ShellFields {
   // relative velocity and a bit per node that has relative velocities.
   std::vector<int> fblock_;
   std::vector<std::array<Vec3, kBlockNodes>> r_bulk_;
+  std::vector<char> fielded_;  ///< per combined grid block: a shell field is present
+  std::vector<std::array<Moment, kPadNodes>> bulk_buf_;   ///< per combined particle block
+  std::vector<std::array<Moment, kBlockNodes>> bulk_mom_;  ///< per combined grid block
   std::vector<std::uint64_t> shared_;
 };
 

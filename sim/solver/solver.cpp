@@ -190,7 +190,7 @@ void Solver::add_grid_stages() {
                          };
                        particles_to_grid(particles_, grid_, tp);
                        if (shell_fields_.active())
-                         shell_fields_.p2g(grid_, grid_shells_, dt, opt_.serial);
+                         shell_fields_.p2g(grid_, grid_shells_, dt, &particles_, tp.first_bulk, opt_.serial);
                      }});
   stages_.push_back({"grid", [this] { grid_update(); }});
   if (on_grid)
