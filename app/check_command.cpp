@@ -4,6 +4,7 @@
 #include "app/scene_loading.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
+#include "sim/solver/step_limits.h"
 
 namespace shellmpm {
 
@@ -76,16 +77,10 @@ int check_command(const CommonArgs& a) {
   const double grid_bytes = n0 > 0 ? static_cast<double>(grid.bytes()) / n0 : 21.0;
   const double mem = (per_particle + grid_bytes) * static_cast<double>(peak);
   std::printf("memory: about %.1f MiB at the peak of %zu particles\n", mem / (1024.0 * 1024.0), peak);
-  // The step: CFL on the current particles, plus the sources' speeds and the wave speeds
-  // of the materials that are still to be emitted.
-  double dt = solver.stable_dt();
-  for (const SourceDesc& src : scene.sources) {
-    const double v = src.velocity.norm();
-    if (v > 0) dt = std::min(dt, s.cfl * s.dx / v);
-    const ConstitutiveModel& m = solver.models()[src.material];
-    const double c = m.wave_speed(solver.densities()[src.material], m.initial_plastic());
-    if (c > 0) dt = std::min(dt, s.cfl * s.dx / c);
-  }
+  // The step: the solver's bounds on the current particles and shells, plus the speeds
+  // and wave speeds (at rest) of what the sources are still to emit.
+  const std::vector<StepLimit> limits = step_limits(solver, /*upcoming=*/true);
+  const double dt = limits.front().dt;
   const double steps = std::ceil(1.0 / s.fps / dt);
   double harden = 1;
   for (const ConstitutiveModel& m : solver.models())
@@ -99,8 +94,20 @@ int check_command(const CommonArgs& a) {
   const double sec =
       steps * static_cast<double>(peak) / (kParticleStepsPerSecondPerThread * threads);
   std::printf("time step: about %.3g s (%g substeps per frame)\n", dt, steps);
+  // What sets it: the smallest bounds, smallest first.
+  for (std::size_t i = 0; i < limits.size() && i < 3; ++i)
+    std::printf("%s%s (%.2g s)\n",
+                i == 0 ? "time step limited by: " : "  then: ", limits[i].detail.c_str(),
+                limits[i].dt);
   std::printf("estimated time per frame at the peak: %.2f s on %d threads (at %.1fM particle-steps/s/thread)\n",
               sec, threads, kParticleStepsPerSecondPerThread / 1e6);
+  // A step below dt_min stops the run; say so now, with the cause (a warning: exit 0).
+  if (dt < s.dt_min)
+    std::printf(
+        "warning: the stable step %.2g s is below shot.dt_min = %g s, so `shellmpm run` "
+        "will stop %s; %s\n",
+        dt, s.dt_min, limits.front().upcoming ? "once the sources emit" : "at t = 0",
+        describe_step_limits(limits, s.dt_min).c_str());
   return kExitOk;
 }
 

@@ -121,8 +121,13 @@ ShellObject::ShellObject(const ShellDesc& desc, const ShellMaterialDesc& mat, Sh
     if (pin_mask[i]) v[i].setZero();
   min_edge_ = 1e300;
   for (const auto& t : tris_)
-    for (int e = 0; e < 3; ++e)
-      min_edge_ = std::min(min_edge_, (rest[t[e]] - rest[t[(e + 1) % 3]]).norm());
+    for (int e = 0; e < 3; ++e) {
+      const double len = (rest[t[e]] - rest[t[(e + 1) % 3]]).norm();
+      if (len < min_edge_) {
+        min_edge_ = len;
+        min_edge_vertices_ = {t[e], t[(e + 1) % 3]};
+      }
+    }
 }
 
 KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector<Vec3>& f,

@@ -3,6 +3,7 @@
 // points directly (symplectic Euler, no grid); with contact (issue 4) the same forces
 // go through the MPM grid.
 #pragma once
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +66,9 @@ class ShellObject {
   const std::vector<Eigen::Vector3i>& triangles() const { return tris_; }
   /// Shortest rest control-mesh edge [m].
   double min_edge() const { return min_edge_; }
+  /// The two control points (0-based, as pins.indices) of that edge, the first one met in
+  /// triangle order when several are equally short.
+  const std::array<int, 2>& min_edge_vertices() const { return min_edge_vertices_; }
   KirchhoffLoveShell& kl() { return *kl_; }
   const KirchhoffLoveShell& kl() const { return *kl_; }
 
@@ -82,6 +86,7 @@ class ShellObject {
   std::unique_ptr<KirchhoffLoveShell> kl_;
   std::unique_ptr<LimitMesh> limit_;
   double min_edge_ = 0;
+  std::array<int, 2> min_edge_vertices_{{-1, -1}};
 };
 
 }  // namespace shellmpm

@@ -9,6 +9,7 @@
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
 #include "sim/mpm/transfer.h"
+#include "sim/solver/step_limits.h"
 
 namespace shellmpm {
 namespace {
@@ -449,9 +450,9 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
     }
     if (dt < scene_.shot.dt_min && remaining > scene_.shot.dt_min) {
       std::ostringstream os;
-      os << "at t = " << time_ << " s the stable step " << dt << " s is below shot.dt_min = "
-         << scene_.shot.dt_min << " s (max speed or stiffness too high for dx = "
-         << scene_.shot.dx << ")";
+      os << "at t = " << time_ << " s the stable step " << dt
+         << " s is below shot.dt_min = " << scene_.shot.dt_min << " s, "
+         << describe_step_limits(step_limits(*this), scene_.shot.dt_min);
       throw SimulationError(os.str());
     }
     const double steps = std::max(1.0, std::ceil(remaining / dt - 1e-9));

@@ -61,6 +61,8 @@ class Solver {
   const std::vector<Real>& densities() const { return densities_; }
   const std::vector<SourceSampler>& samplers() const { return samplers_; }
   const Scene& scene() const { return scene_; }
+  /// Colliders in scene order (their pose is that of the last step).
+  const std::vector<Collider>& colliders() const { return colliders_; }
   std::vector<std::unique_ptr<ShellObject>>& shells() { return shells_; }
   const std::vector<std::unique_ptr<ShellObject>>& shells() const { return shells_; }
   /// Shells whose control points are MPM particles (contact on), in scene order.
