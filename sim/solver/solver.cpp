@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "sim/collider/particle_projection.h"
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
 #include "sim/mpm/transfer.h"
@@ -217,6 +218,15 @@ void Solver::add_grid_stages() {
                        if (fields) shell_fields_.after_g2p(grid_shells_, dt, opt_.serial);
                        clamp_to_domain();
                      }});
+  if (!colliders_.empty())
+    stages_.push_back({"collider_particles", [this] {
+                         const double dx = grid_.dx();
+                         project_out_of_colliders(colliders_, dx, dt_, particles_.x, particles_.v,
+                                                  nullptr, opt_.serial);
+                         for (GridShell& g : grid_shells_)
+                           project_out_of_colliders(colliders_, dx, dt_, g.shell->x, g.shell->v,
+                                                    &g.held, opt_.serial);
+                       }});
   if (on_grid)
     stages_.push_back({"friction", [this] {
                          ContactStepStats total;

@@ -71,7 +71,7 @@ TEST_CASE("a falling block stops on a ground plane collider", "[solver][collider
   s.sources[0].velocity = Vec3d(0, -2, 0);
   Solver solver(s);
   REQUIRE(solver.stage_names() ==
-          std::vector<std::string>{"bin", "p2g", "grid", "colliders", "g2p"});
+          std::vector<std::string>{"bin", "p2g", "grid", "colliders", "g2p", "collider_particles"});
   // Before contact: free fall. Contact begins when the bottom (y = 2.0) reaches ~1.5 + dx.
   const FrameStats early = solver.advance_to(0.1);
   const double t = solver.time();
@@ -132,7 +132,7 @@ TEST_CASE("a sand column collapses and comes to rest with no particle lost", "[s
   s.colliders.push_back(ground);
   Solver solver(s);
   REQUIRE(solver.stage_names() ==
-          std::vector<std::string>{"bin", "p2g", "grid", "colliders", "g2p", "plasticity"});
+          std::vector<std::string>{"bin", "p2g", "grid", "colliders", "g2p", "collider_particles", "plasticity"});
   const std::size_t n0 = solver.particles().size();
   FrameStats fs0;
   solver.measure(fs0);
