@@ -206,6 +206,7 @@ std::vector<KeySpec> build_schema() {
       Spec("shell_materials[].density", T::Number).def("1000").unit("kg/m^3").gt(0),
       Spec("shell_materials[].thickness", T::Number).def("0.001").unit("m").gt(0),
       Spec("shell_materials[].yield_stress", T::Number).def("0").unit("Pa").ge(0),
+      Spec("shell_materials[].stretch_limit", T::Number).def("1.5").gt(1).le(1.9),
       Spec("shell_materials[].damping", T::Number).def("0").unit("1/s").ge(0),
       Spec("shell_materials[].stiffness_damping", T::Number).def("0").unit("s").ge(0),
       Spec("shell_materials[].quadrature_inplane", T::Int).def("3").rule("one of: 1, 3, 6, 7"),
@@ -1455,6 +1456,7 @@ ShellMaterialDesc read_shell_material(const DocNode& node, const std::string& pa
   m.density = r.number("density");
   m.thickness = r.number("thickness");
   m.yield_stress = r.number("yield_stress");
+  m.stretch_limit = r.number("stretch_limit");
   m.damping = r.number("damping");
   m.stiffness_damping = r.number("stiffness_damping");
   m.quadrature_inplane = r.int32("quadrature_inplane");

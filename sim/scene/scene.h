@@ -119,6 +119,9 @@ struct ShellMaterialDesc {
   double density = 1000.0;      ///< [kg/m^3]
   double thickness = 1e-3;      ///< t [m]
   double yield_stress = 0.0;    ///< von Mises yield [Pa]; 0 = no denting (no plasticity stage)
+  /// Principal stretch s_l beyond which the membrane stiffens (kirchhoff_love.h), in
+  /// (1, KirchhoffLoveShellT::kMaxStretchLimit]; below it the energy is plain Hencky.
+  double stretch_limit = 1.5;
   double damping = 0.0;         ///< mass-proportional damping rate [1/s]
   double stiffness_damping = 0.0;  ///< Rayleigh stiffness-proportional damping [s]
   int quadrature_inplane = 3;   ///< in-plane points per triangle: 1, 3, 6 or 7

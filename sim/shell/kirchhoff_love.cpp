@@ -78,13 +78,18 @@ inline T atanh_over_x(T x) {
 /// Laminate energy density of one layer (supplement secs. 3-4) from the current metric
 /// M = [g_a . g_b] (m11, m12, m22) and Bp (row-major 2x2): C = Bp^T M Bp has eigenvalues
 /// s_a^2 and psi = mu/4 |log C|^2 + lambda/8 (log det C)^2 = mu |log s|^2 +
-/// lambda/2 (tr log s)^2. If S != nullptr writes dpsi/dM (s11, s12, s22; symmetric,
+/// lambda/2 (tr log s)^2, plus the large-stretch term k sum_a (s_a - s_l)_+^2 (our addition,
+/// kirchhoff_love.h). If S != nullptr writes dpsi/dM (s11, s12, s22; symmetric,
 /// dpsi = sum_ab S_ab dM_ab).
 /// log C = alpha I + beta C with beta = (log c1 - log c2) / (c1 - c2) evaluated as
 /// 2 atanh(x) / (x tr), x = (c1 - c2) / (c1 + c2), which is stable at c1 = c2, and
 /// dpsi/dC = C^-1 (mu/2 log C + lambda/4 log det C I).
-template <class T>
-inline T layer_psi(T mu, T lambda, const T* Bp, T m11, T m12, T m22, T* S) {
+/// The stretch term is a spectral function of C: with g_a = dpsi_s/dc_a = k (s_a - s_l)_+ /
+/// s_a, its gradient is g_1 P_1 + g_2 P_2 = a I + b C, b = (g_1 - g_2) / (c_1 - c_2),
+/// a = g_2 - b c_2. Both s_a > s_l: b = k s_l / (s_1 s_2 (s_1 + s_2)) exactly (no
+/// cancellation at s_1 = s_2). Only s_1 > s_l >= s_2: c_1 - c_2 = 2h >= s_1^2 - s_l^2 > 0.
+template <class T, class Stiffening>
+inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m12, T m22, T* S) {
   // Columns of Bp: (Bp[0], Bp[2]) and (Bp[1], Bp[3]).
   const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
   const T mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
@@ -100,14 +105,37 @@ inline T layer_psi(T mu, T lambda, const T* Bp, T m11, T m12, T m22, T* S) {
   const T q = atanh_over_x(x);
   const T L = std::log(det);  // log c1 + log c2
   const T D = T(2) * x * q;   // log c1 - log c2
-  const T psi = T(0.125) * mu * (L * L + D * D) + T(0.125) * lambda * L * L;
+  T psi = T(0.125) * mu * (L * L + D * D) + T(0.125) * lambda * L * L;
+  // Large-stretch term; l1 = log s1 >= l2 = log s2. Untaken below the limit (bitwise Hencky).
+  const bool beyond = T(0.25) * (L + D) > st.log_limit;
+  T stretch_i = 0, stretch_c = 0;  // its gradient in C: stretch_i I + stretch_c C
+  if (beyond) {
+    const T s1 = std::exp(T(0.25) * (L + D)), s2 = std::exp(T(0.25) * (L - D));
+    const T d1 = std::max(s1 - st.limit, T(0));
+    const T g1 = st.k * d1 / s1;
+    if (s2 > st.limit) {
+      const T d2 = s2 - st.limit;
+      psi += st.k * (d1 * d1 + d2 * d2);
+      stretch_c = st.k * st.limit / (s1 * s2 * (s1 + s2));
+      stretch_i = st.k * d2 / s2 - stretch_c * s2 * s2;
+    } else {
+      psi += st.k * d1 * d1;
+      stretch_c = d1 > T(0) ? g1 / (T(2) * h) : T(0);  // d1 > 0 here implies s1 > s2, h > 0
+      stretch_i = -stretch_c * s2 * s2;
+    }
+  }
   if (S) {
     const T beta = T(2) * q / tr;
     const T alpha = T(0.5) * (L - beta * tr);
     const T k = (T(0.5) * mu * alpha + T(0.25) * lambda * L) / det;
     const T d = T(0.5) * mu * beta;
-    // dpsi/dC = k adj(C) + d I
-    const T s11 = k * c22 + d, s12 = -k * c12, s22 = k * c11 + d;
+    // dpsi/dC = k adj(C) + d I (+ stretch_i I + stretch_c C beyond the limit)
+    T s11 = k * c22 + d, s12 = -k * c12, s22 = k * c11 + d;
+    if (beyond) {
+      s11 += stretch_i + stretch_c * c11;
+      s12 += stretch_c * c12;
+      s22 += stretch_i + stretch_c * c22;
+    }
     // dpsi/dM = Bp S_C Bp^T
     const T r00 = b00 * s11 + b01 * s12, r01 = b00 * s12 + b01 * s22;
     const T r10 = b10 * s11 + b11 * s12, r11 = b10 * s12 + b11 * s22;
@@ -168,14 +196,19 @@ KirchhoffLoveShellT<T>::KirchhoffLoveShellT(std::vector<BasisPoint> points,
   SHELLMPM_CHECK(points.size() == inplane_weights.size(),
                  "points " << points.size() << " weights " << inplane_weights.size());
   SHELLMPM_CHECK(mat.youngs_modulus > 0 && mat.poisson_ratio > -1 && mat.poisson_ratio < 0.5 &&
-                     mat.thickness > 0 && mat.yield_stress >= 0,
+                     mat.thickness > 0 && mat.yield_stress >= 0 && mat.stretch_limit > 1 &&
+                     mat.stretch_limit <= kMaxStretchLimit,
                  "material E " << mat.youngs_modulus << " nu " << mat.poisson_ratio << " t "
-                               << mat.thickness << " yield " << mat.yield_stress);
+                               << mat.thickness << " yield " << mat.yield_stress
+                               << " stretch limit " << mat.stretch_limit);
   const double E = mat.youngs_modulus, nu = mat.poisson_ratio, t = mat.thickness;
   num_ctrl_ = rest.size();
   mu_ = T(E / (2.0 * (1.0 + nu)));
   lambda_ = T(E * nu / (1.0 - nu * nu));  // = 2 mu lambda / (lambda + 2 mu): plane stress
   yield_ = T(mat.yield_stress);
+  stiffening_.limit = T(mat.stretch_limit);
+  stiffening_.log_limit = T(std::log(mat.stretch_limit));
+  stiffening_.k = T(kStretchStiffening * (E / (2.0 * (1.0 + nu)) + E * nu / (1.0 - nu * nu)));
   thickness_ = T(t);
   rho_ = mat.density;
   thickness_d_ = t;
@@ -323,7 +356,7 @@ void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, 
     }
     const T V = area * layer_w_[l];
     T S[3];
-    energy += V * layer_psi(mu_, lambda_, B, m11, m12, m22, grad ? S : nullptr);
+    energy += V * layer_psi(mu_, lambda_, stiffening_, B, m11, m12, m22, grad ? S : nullptr);
     if (grad) {
       const T s = T(2) * V;
       const V3 dg1 = s * (S[0] * g1 + S[1] * g2);
@@ -344,8 +377,8 @@ void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, 
       B0 = Bp0;
     }
     e_membrane += double(area * thickness_ *
-                         layer_psi(mu_, lambda_, B0, k.a1.dot(k.a1), k.a1.dot(k.a2), k.a2.dot(k.a2),
-                                   static_cast<T*>(nullptr)));
+                         layer_psi(mu_, lambda_, stiffening_, B0, k.a1.dot(k.a1), k.a1.dot(k.a2),
+                                   k.a2.dot(k.a2), static_cast<T*>(nullptr)));
   }
   if (!grad) return;
 

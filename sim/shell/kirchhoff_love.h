@@ -17,6 +17,31 @@
 // C = (r^E)^T r^E = Bp^T M Bp, with M_ab = g_a . g_b and Bp = B (F^P)^-1,
 // B_ba = gbar^b . e_a fixed at rest; log C is evaluated in closed form.
 //
+// Large-stretch stiffening (our addition beyond the supplement, which has plain Hencky;
+// issue 10). Hencky's force along a principal stretch, dpsi/ds_a = (2 mu log s_a +
+// lambda_ps tr log s) / s_a, peaks near s_a = e and then falls: a sheet pulled past ~2.7x
+// necks without bound. Beyond a stretch limit s_l (ShellMaterialDesc::stretch_limit,
+// default 1.5) each singular value adds
+//   psi_s = k sum_a max(s_a - s_l, 0)^2,   k = (mu + lambda_ps) / 8 = E / (16 (1 - nu)).
+// - C1 at s_l: energy and force are continuous, d2psi/ds_a^2 jumps by 2k. Where both
+//   s_a <= s_l the energy and forces are bitwise those of plain Hencky.
+// - Range of the guarantee: 0 <= nu < 1/2, 1 < s_l <= kMaxStretchLimit = 1.9, a the larger
+//   stretch (s_b <= s_a). There
+//     d2psi/ds_a^2 = (d (1 - log s_a) - lambda_ps log s_b) / s_a^2 + 2k [s_a > s_l],
+//   d = 2 mu + lambda_ps = E / (1 - nu^2), is positive for every s_a: the Hencky part is
+//   positive up to log s_a = 1 / (1 + nu) (>= 2/3: s_a >= 1.95 > s_l), and its most
+//   negative value, -(mu + lambda_ps) e^{-1 - 2/(1+nu)} > -0.097 (mu + lambda_ps) (at
+//   s_b = s_a, log s_a = 1/2 + 1/(1+nu); with s_b = 1 it is -d e^{-3} / 2 at
+//   s_a = e^{3/2}), is above -2k = -(mu + lambda_ps) / 4. So the force along the larger
+//   principal stretch rises monotonically for all s_a and the energy grows without bound.
+// - The smaller stretch keeps Hencky's Poisson coupling: its curvature is positive while
+//   log s_a < (1 - log s_b) / nu.
+// - Time step: past s_l = 1.5 (with s_b >= 1) the tangent, at most 0.26 d from Hencky plus
+//   2k = (1 + nu) d / 8, stays below the small-strain d, so the rest wave speed in
+//   ShellObject::stable_dt still bounds the step.
+// - Denting (denting.h) returns with the Hencky stress; with a yield stress << E its
+//   elastic stretches stay far below s_l.
+//
 // Quadrature and volume: V_{q,k} = w_q |abar_1 x abar_2| (t/2) w_k (mid-surface area
 // times the Gauss layer thickness; the curvature shift of the volume element,
 // det(gbar) / det(abar) = 1 + O(t kappa), is NOT included, a standard thin-shell choice).
@@ -61,6 +86,12 @@ class KirchhoffLoveShellT {
  public:
   using Vec3T = Eigen::Matrix<T, 3, 1>;
   using Mat2T = Eigen::Matrix<T, 2, 2>;
+
+  /// Largest allowed ShellMaterialDesc::stretch_limit (see the file comment: below
+  /// e^{2/3} = 1.95 the Hencky term is convex along the larger stretch for any nu in [0, 1/2)).
+  static constexpr double kMaxStretchLimit = 1.9;
+  /// k = kStretchStiffening (mu + lambda_ps): the coefficient of (s_a - s_l)^2 [Pa].
+  static constexpr double kStretchStiffening = 0.125;
 
   /// points: one BasisPoint per in-plane quadrature point; inplane_weights: their
   /// parametric weights (sum 1/2 per triangle; the area factor |abar_1 x abar_2| is
@@ -109,6 +140,9 @@ class KirchhoffLoveShellT {
   bool has_plasticity() const { return yield_ > 0; }
   T mu() const { return mu_; }
   T lambda_plane_stress() const { return lambda_; }
+  /// Stretch limit s_l and stiffening coefficient k [Pa] of psi_s = k sum (s_a - s_l)_+^2.
+  T stretch_limit() const { return stiffening_.limit; }
+  T stretch_stiffness() const { return stiffening_.k; }
   /// Rest area of the shell sum_q w_q |abar_1 x abar_2| [m^2].
   double rest_area() const { return rest_area_; }
 
@@ -118,9 +152,15 @@ class KirchhoffLoveShellT {
   void eval_point(std::size_t q, const Vec3T* x, T* grad, double& e_total,
                   double& e_membrane) const;
 
+  /// The large-stretch term: s_l, log s_l and k.
+  struct Stiffening {
+    T limit = 0, log_limit = 0, k = 0;
+  };
+
   std::size_t num_ctrl_ = 0;
   int num_layers_ = 0;
   T mu_ = 0, lambda_ = 0, yield_ = 0, thickness_ = 0;
+  Stiffening stiffening_;
   double rho_ = 0, thickness_d_ = 0, rest_area_ = 0;
   std::vector<std::size_t> begin_;      // entries of quadrature point q: [begin_[q], begin_[q+1])
   std::vector<int> ctrl_;               // control point of each entry

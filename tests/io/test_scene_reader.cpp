@@ -587,6 +587,7 @@ TEST_CASE("a shell scene parses with the values written", "[scene][shell]") {
   CHECK(cotton.quadrature_inplane == 6);
   CHECK(cotton.quadrature_thickness == 5);
   CHECK(s.shell_materials[1].name == "tin");
+  CHECK(s.shell_materials[1].stretch_limit == 1.7);
 
   REQUIRE(s.shells.size() == 4);
   const ShellDesc& cloth = s.shells[0];
@@ -710,6 +711,7 @@ TEST_CASE("shell keys left out take the defaults of scene.h", "[scene][shell]") 
   CHECK(m.density == md.density);
   CHECK(m.thickness == md.thickness);
   CHECK(m.yield_stress == md.yield_stress);
+  CHECK(m.stretch_limit == md.stretch_limit);
   CHECK(m.damping == md.damping);
   CHECK(m.stiffness_damping == md.stiffness_damping);
   CHECK(m.quadrature_inplane == md.quadrature_inplane);
@@ -875,6 +877,10 @@ TEST_CASE("bad shell scenes name the file, line and key", "[scene][shell]") {
                  "shell_materials[0].quadrature_thickness", {"must be in [1, 5], got 6"});
     expect_error(kHead + "shell_materials:\n  - {name: m, poisson_ratio: 0.5}\n", 6,
                  "shell_materials[0].poisson_ratio", {"must be in [0, 0.5)"});
+    expect_error(kHead + "shell_materials:\n  - {name: m, stretch_limit: 1}\n", 6,
+                 "shell_materials[0].stretch_limit", {"must be in (1, 1.9], got 1"});
+    expect_error(kHead + "shell_materials:\n  - {name: m, stretch_limit: 2.5}\n", 6,
+                 "shell_materials[0].stretch_limit", {"must be in (1, 1.9], got 2.5"});
     expect_error(kHead + "shell_materials:\n  - {name: m, density: 1, type: elastic}\n", 6,
                  "shell_materials[0].type", {"unknown key 'type' in shell_materials[0]"});
   }

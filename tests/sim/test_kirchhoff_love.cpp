@@ -320,3 +320,169 @@ TEST_CASE("KL float evaluation matches double", "[kl]") {
   for (std::size_t i = 0; i < x.size(); ++i)
     CHECK((ff[i].cast<double>() - fd[i]).norm() < 2e-3 * scale);
 }
+
+// ---- Large-stretch stiffening (kirchhoff_love.h; issue 10) ----
+
+namespace {
+
+/// The rest patch's (x, y) mapped by Rot(0.7) diag(s1, s2) Rot(0.3), z kept, then a
+/// rotation: for a flat rest an affine stretch with singular values s1, s2.
+std::vector<V3> affine_stretch(const std::vector<V3>& rest, double s1, double s2) {
+  const Eigen::Matrix2d U = Eigen::Rotation2Dd(0.7).toRotationMatrix();
+  const Eigen::Matrix2d W = Eigen::Rotation2Dd(-0.3).toRotationMatrix();
+  const Eigen::Matrix2d A = U * Eigen::Vector2d(s1, s2).asDiagonal() * W.transpose();
+  const Eigen::Matrix3d Rm =
+      Eigen::AngleAxisd(0.4, V3(0.3, -1, 0.5).normalized()).toRotationMatrix();
+  std::vector<V3> x = rest;
+  for (V3& v : x) {
+    const Eigen::Vector2d p = A * v.head<2>();
+    v = Rm * V3(p.x(), p.y(), v.z());
+  }
+  return x;
+}
+
+/// Membrane force resultant along x of the patch stretched by (s1, s2) along (x, y):
+/// dE/ds1 [N m] from the kernel's forces (x_j = (s1 X_j, s2 Y_j, 0), dx_j/ds1 = (X_j, 0, 0)).
+double force_along_x(const Shell& sh, const std::vector<V3>& rest, double s1, double s2,
+                     double* energy) {
+  std::vector<V3> x = rest;
+  for (V3& v : x) {
+    v.x() *= s1;
+    v.y() *= s2;
+  }
+  std::vector<V3> f(x.size(), V3::Zero());
+  *energy = sh.energy(x.data(), f.data()).total;
+  double dE = 0;
+  for (std::size_t j = 0; j < x.size(); ++j) dE -= f[j].x() * rest[j].x();
+  return dE;
+}
+
+}  // namespace
+
+TEST_CASE("KL stretch term: energy of an affine stretch is Hencky + k (s - s_l)_+^2",
+          "[kl][membrane_stretch]") {
+  const BezierShell s = make_bezier_grid(2, 3, 7);
+  const std::vector<V3> rest = interpolate(s, flat_map);
+  for (double nu : {0.0, 0.3, 0.45}) {
+    shellmpm::ShellMaterialDesc mat = test_material(0.01);
+    mat.poisson_ratio = nu;
+    const Shell sh = make_shell(s, rest, mat);
+    const shellmpm::KirchhoffLoveShellT<float> shf(s.points, s.weights, rest, mat, 3);
+    const double E = mat.youngs_modulus, sl = mat.stretch_limit;
+    const double k = E / (16 * (1 - nu));
+    CHECK(sl == 1.5);
+    CHECK(sh.stretch_limit() == sl);
+    CHECK(sh.stretch_stiffness() == Approx(k).epsilon(1e-14));
+    const double mu = E / (2 * (1 + nu)), lam = E * nu / (1 - nu * nu);
+    // Below, one beyond, both beyond (equal singular values exactly), both beyond unequal,
+    // one beyond with the other compressed.
+    for (const auto& st : std::vector<std::pair<double, double>>{
+             {1.4, 1.2}, {3.0, 1.0}, {3.0, 3.0}, {2.5, 1.8}, {1.51, 1.49}, {4.0, 0.7}}) {
+      const double l1 = std::log(st.first), l2 = std::log(st.second);
+      const double d1 = std::max(st.first - sl, 0.0), d2 = std::max(st.second - sl, 0.0);
+      const double psi =
+          mu * (l1 * l1 + l2 * l2) + 0.5 * lam * (l1 + l2) * (l1 + l2) + k * (d1 * d1 + d2 * d2);
+      const std::vector<V3> x = affine_stretch(rest, st.first, st.second);
+      const auto e = sh.energy(x.data(), nullptr);
+      INFO("nu " << nu << " s " << st.first << ", " << st.second);
+      CHECK(e.total == Approx(mat.thickness * psi).epsilon(1e-10));  // unit area
+      CHECK(std::abs(e.bending) < 1e-9 * e.total);
+      std::vector<Eigen::Vector3f> xf(x.size());
+      for (std::size_t i = 0; i < x.size(); ++i) xf[i] = x[i].cast<float>();
+      CHECK(shf.energy(xf.data(), nullptr).total == Approx(e.total).epsilon(1e-4));
+    }
+  }
+}
+
+TEST_CASE("KL stretch term: forces are the gradient of the energy past the limit",
+          "[kl][membrane_stretch]") {
+  std::mt19937 rng(17);
+  const BezierShell s = make_bezier_grid(2, 3, 7);
+  for (int curved = 0; curved < 2; ++curved) {
+    const std::vector<V3> rest = interpolate(s, curved ? curved_map : flat_map);
+    for (double t : {0.02, 0.1}) {
+      const Shell sh = make_shell(s, rest, test_material(t), 3);
+      // One stretch beyond the limit, both (nearly equal), one far past with the other
+      // compressed, and (flat, affine: uniform) both just past it. Every point stays clear
+      // of the kink at s_l, where the central difference is only first order.
+      for (const auto& st : std::vector<std::pair<double, double>>{
+               {3.0, 1.0}, {2.5, 2.5}, {4.5, 0.7}, {1.56, 1.54}}) {
+        const bool near_limit = st.first < 2;
+        if (near_limit && curved) continue;  // a curved rest would spread s across s_l
+        std::vector<V3> x = affine_stretch(rest, st.first, st.second);
+        if (!near_limit) x = perturbed(x, 0.01, rng);
+        INFO("curved " << curved << " t " << t << " s " << st.first << ", " << st.second);
+        REQUIRE(sh.max_strain(x.data()) > std::log(sh.stretch_limit()));
+        check_fd(sh, x, rng);
+      }
+    }
+  }
+}
+
+TEST_CASE("KL stretch term: float matches double; nothing changes below the limit",
+          "[kl][membrane_stretch]") {
+  std::mt19937 rng(5);
+  const BezierShell s = make_bezier_grid(2, 3, 6);
+  const std::vector<V3> rest = interpolate(s, curved_map);
+  {  // past the limit: the float kernel follows the double one
+    const Shell shd = make_shell(s, rest, test_material());
+    const shellmpm::KirchhoffLoveShellT<float> shf(s.points, s.weights, rest, test_material(), 3);
+    const std::vector<V3> x = perturbed(affine_stretch(rest, 3.0, 2.0), 0.03, rng);
+    std::vector<Eigen::Vector3f> xf(x.size()), ff(x.size(), Eigen::Vector3f::Zero());
+    for (std::size_t i = 0; i < x.size(); ++i) xf[i] = x[i].cast<float>();
+    const std::vector<V3> fd = forces_of(shd, x);
+    CHECK(shf.energy(xf.data(), ff.data()).total == Approx(energy_of(shd, x)).epsilon(1e-3));
+    const double scale = max_norm(fd);
+    for (std::size_t i = 0; i < x.size(); ++i)
+      CHECK((ff[i].cast<double>() - fd[i]).norm() < 2e-3 * scale);
+  }
+  // Below the limit the energy and forces are bitwise those of a higher limit (plain Hencky).
+  shellmpm::ShellMaterialDesc high = test_material();
+  high.stretch_limit = Shell::kMaxStretchLimit;
+  const Shell sh = make_shell(s, rest, test_material()), shh = make_shell(s, rest, high);
+  const shellmpm::KirchhoffLoveShellT<float> shf(s.points, s.weights, rest, test_material(), 3);
+  const shellmpm::KirchhoffLoveShellT<float> shfh(s.points, s.weights, rest, high, 3);
+  const std::vector<V3> x = perturbed(affine_stretch(rest, 1.3, 0.9), 0.02, rng);
+  REQUIRE(sh.max_strain(x.data()) < std::log(1.45));
+  const std::vector<V3> f = forces_of(sh, x), fh = forces_of(shh, x);
+  const auto e = sh.energy(x.data(), nullptr), eh = shh.energy(x.data(), nullptr);
+  CHECK(e.total == eh.total);
+  CHECK(e.membrane == eh.membrane);
+  std::vector<Eigen::Vector3f> xf(x.size()), ff(x.size(), Eigen::Vector3f::Zero()),
+      ffh(x.size(), Eigen::Vector3f::Zero());
+  for (std::size_t i = 0; i < x.size(); ++i) xf[i] = x[i].cast<float>();
+  CHECK(shf.energy(xf.data(), ff.data()).total == shfh.energy(xf.data(), ffh.data()).total);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    CHECK(f[i] == fh[i]);
+    CHECK(ff[i] == ffh[i]);
+  }
+}
+
+TEST_CASE("KL membrane force of a stretched element grows monotonically from s = 1 to 5",
+          "[kl][membrane_stretch]") {
+  // Plain Hencky peaks at s = e (uniaxial strain: (2 mu + lambda) log(s) / s) and fails here.
+  const BezierShell s = make_bezier_grid(1, 2, 3);
+  const std::vector<V3> rest = interpolate(s, flat_map);
+  for (double nu : {0.0, 0.3, 0.45}) {
+    shellmpm::ShellMaterialDesc mat = test_material(0.01);
+    mat.poisson_ratio = nu;
+    const Shell sh = make_shell(s, rest, mat);
+    // Lateral stretch held at 1 (uniaxial strain), contracted, and stretched a little.
+    for (double s2 : {1.0, 0.8, 1.25}) {
+      double e_prev = 0;
+      double f_prev = force_along_x(sh, rest, 1.0, s2, &e_prev);
+      for (int i = 1; i <= 200; ++i) {
+        const double s1 = 1.0 + 4.0 * i / 200;
+        double e = 0;
+        const double f = force_along_x(sh, rest, s1, s2, &e);
+        INFO("nu " << nu << " s2 " << s2 << " s1 " << s1 << " force " << f << " previous "
+                   << f_prev);
+        REQUIRE(std::isfinite(f));
+        REQUIRE(f > f_prev);                 // d2E/ds1^2 > 0
+        if (s1 > 1.25) REQUIRE(e > e_prev);  // past the lateral stretch: dE/ds1 > 0
+        f_prev = f;
+        e_prev = e;
+      }
+    }
+  }
+}
