@@ -224,7 +224,9 @@ class ShellSurface {
         const double c = e1.dot(e2) / std::max(e1.norm() * e2.norm(), 1e-300);
         vert_n_[tr[k]] += std::acos(std::clamp(c, -1.0, 1.0)) * face_n_[t];
         const int a = std::min(tr[k], tr[(k + 1) % 3]), b = std::max(tr[k], tr[(k + 1) % 3]);
-        edge_n_[{a, b}] += face_n_[t];
+        const auto [it, fresh] = edge_n_.try_emplace({a, b}, V3::Zero());  // Eigen does not zero
+        (void)fresh;
+        it->second += face_n_[t];
       }
     }
     boxes_ = detail::triangle_boxes(m, band_);
@@ -315,18 +317,19 @@ inline std::vector<SideSample> sample_all(const ShellSurface& surf, const std::v
 
 /// How many points crossed a surface between two frames, from their samples in each
 /// (`before` with ids `ids_before`, `after` with `ids_after`; points are matched by id,
-/// those in one frame only are skipped). `first`: index (in `after`) of the first one.
+/// those in one frame only are skipped). `which`: (index before, index after) of each.
 template <class Id>
 std::size_t count_flips(const std::vector<SideSample>& before, const std::vector<Id>& ids_before,
                         const std::vector<SideSample>& after, const std::vector<Id>& ids_after,
-                        double locality, std::size_t* first = nullptr) {
+                        double locality,
+                        std::vector<std::pair<std::size_t, std::size_t>>* which = nullptr) {
   std::map<Id, std::size_t> index;
   for (std::size_t i = 0; i < ids_before.size(); ++i) index[ids_before[i]] = i;
   std::size_t n = 0;
   for (std::size_t j = 0; j < after.size(); ++j) {
     const auto it = index.find(ids_after[j]);
     if (it == index.end() || !crossed(before[it->second], after[j], locality)) continue;
-    if (n == 0 && first) *first = j;
+    if (which) which->emplace_back(it->second, j);
     ++n;
   }
   return n;
