@@ -298,6 +298,8 @@ std::string check_run(const Run& r, const WorkBound& work) {
          << s1.rest.transpose() << ")";
     crossing_text.push_back(os.str());
   };
+  // Point-frame pairs that had a side in both frames (how much the side test saw).
+  std::size_t bulk_judged = 0, point_judged = 0;
   // Samples of the previous frame: bulk vs shell s, shell a's vertices vs shell b.
   std::vector<std::vector<SideSample>> bulk_prev(ns);
   std::vector<std::vector<std::vector<SideSample>>> pts_prev(ns, std::vector<std::vector<SideSample>>(ns));
@@ -366,7 +368,7 @@ std::string check_run(const Run& r, const WorkBound& work) {
         if (k > 0) {
           std::vector<std::pair<std::size_t, std::size_t>> which;
           bulk_flips += count_flips(bulk_prev[s], r.particles[k - 1].id, now, r.particles[k].id,
-                                    kLocalityCells * dx, &which);
+                                    kLocalityCells * dx, &which, &bulk_judged);
           for (const auto& [i, j] : which)
             note_crossing(f, "particle " + std::to_string(r.particles[k].id[j]), sc.shells[s].name,
                           r.particles[k - 1].x[i], bulk_prev[s][i], r.particles[k].x[j], now[j]);
@@ -379,7 +381,7 @@ std::string check_run(const Run& r, const WorkBound& work) {
         if (k > 0) {
           std::vector<std::pair<std::size_t, std::size_t>> which;
           point_flips += count_flips(pts_prev[a][s], vertex_ids[a], now, vertex_ids[a],
-                                     kLocalityCells * dx, &which);
+                                     kLocalityCells * dx, &which, &point_judged);
           for (const auto& [i, j] : which)
             note_crossing(f, sc.shells[a].name + " vertex " + std::to_string(j), sc.shells[s].name,
                           r.meshes[k - 1][a].x[i], pts_prev[a][s][i], r.meshes[k][a].x[j], now[j]);
@@ -501,7 +503,8 @@ std::string check_run(const Run& r, const WorkBound& work) {
      << " s)\n  independent: non-finite " << nonfinite.text() << ", self-crossing edges " << self_x.text()
      << ", shell-shell edges " << pair_x.text() << ", bulk through shell " << bulk_x.text()
      << ", shell points through shell " << point_x.text() << ", inside colliders " << depth_count.text()
-     << " (deepest " << depth.text(" dx") << ")\n  monitor: self " << mon_self.text() << ", shell-shell "
+     << " (deepest " << depth.text(" dx") << "); judged " << bulk_judged << " particle and "
+     << point_judged << " shell point steps near a shell\n  monitor: self " << mon_self.text() << ", shell-shell "
      << mon_pair.text() << ", bulk " << mon_bulk.text() << ", points " << mon_point.text() << ", deepest "
      << mon_depth.text(" dx") << "; disagreements " << disagreements;
   for (const std::string& d : disagreement_text) os << "\n    " << d;

@@ -317,18 +317,25 @@ inline std::vector<SideSample> sample_all(const ShellSurface& surf, const std::v
 
 /// How many points crossed a surface between two frames, from their samples in each
 /// (`before` with ids `ids_before`, `after` with `ids_after`; points are matched by id,
-/// those in one frame only are skipped). `which`: (index before, index after) of each.
+/// those in one frame only are skipped). `which`: (index before, index after) of each;
+/// `judged` is increased by the points that had a side in both frames (the ones the test
+/// could judge at all).
 template <class Id>
 std::size_t count_flips(const std::vector<SideSample>& before, const std::vector<Id>& ids_before,
                         const std::vector<SideSample>& after, const std::vector<Id>& ids_after,
                         double locality,
-                        std::vector<std::pair<std::size_t, std::size_t>>* which = nullptr) {
+                        std::vector<std::pair<std::size_t, std::size_t>>* which = nullptr,
+                        std::size_t* judged = nullptr) {
   std::map<Id, std::size_t> index;
   for (std::size_t i = 0; i < ids_before.size(); ++i) index[ids_before[i]] = i;
   std::size_t n = 0;
   for (std::size_t j = 0; j < after.size(); ++j) {
     const auto it = index.find(ids_after[j]);
-    if (it == index.end() || !crossed(before[it->second], after[j], locality)) continue;
+    if (it == index.end()) continue;
+    if (judged && before[it->second].state == SideSample::State::Side &&
+        after[j].state == SideSample::State::Side)
+      ++*judged;
+    if (!crossed(before[it->second], after[j], locality)) continue;
     if (which) which->emplace_back(it->second, j);
     ++n;
   }
