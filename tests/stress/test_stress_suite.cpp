@@ -109,11 +109,16 @@ Run run_case(const std::string& name) {
     const char* th = std::getenv("SHELLMPM_STRESS_THREADS");
     const std::string threads = th ? th : "2";
     const auto t0 = std::chrono::steady_clock::now();
-    const CmdResult res = run_shellmpm("run " + scene + " -q --threads " + threads + " -o " + r.dir);
+    const CmdResult res =
+        run_shellmpm("run " + scene + " -q --threads " + threads + " -o " + r.dir);
     r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r.exit_code = res.code;
     r.output = res.output;
-    std::ofstream(record) << json{{"exit_code", r.exit_code}, {"output", r.output}, {"wall_seconds", r.wall_seconds}}.dump(1);
+    std::ofstream(record) << json{
+        {"exit_code", r.exit_code},
+        {"output", r.output},
+        {"wall_seconds",
+         r.wall_seconds}}.dump(1);
   }
   const std::string stats = r.dir + "/stats.json";
   if (!std::filesystem::exists(stats)) return r;
@@ -121,14 +126,17 @@ Run run_case(const std::string& name) {
   for (const json& f : j["frames"]) {
     const int frame = f["frame"].get<int>();
     // A frame stopped by the monitor has statistics but no caches.
-    const std::string probe = r.scene.shells.empty() ? frame_file(r.dir, "particles", frame)
-                                                     : frame_file(r.dir, r.scene.shells[0].name, frame);
+    const std::string probe = r.scene.shells.empty()
+                                  ? frame_file(r.dir, "particles", frame)
+                                  : frame_file(r.dir, r.scene.shells[0].name, frame);
     if (!std::filesystem::exists(probe)) break;
     r.frames.push_back(f);
     std::vector<TriMesh> ms;
-    for (const shellmpm::ShellDesc& s : r.scene.shells) ms.push_back(read_mesh_ply(frame_file(r.dir, s.name, frame)));
+    for (const shellmpm::ShellDesc& s : r.scene.shells)
+      ms.push_back(read_mesh_ply(frame_file(r.dir, s.name, frame)));
     r.meshes.push_back(std::move(ms));
-    if (!r.scene.sources.empty()) r.particles.push_back(read_particle_ply(frame_file(r.dir, "particles", frame)));
+    if (!r.scene.sources.empty())
+      r.particles.push_back(read_particle_ply(frame_file(r.dir, "particles", frame)));
   }
   return r;
 }
@@ -143,7 +151,9 @@ std::size_t non_finite_numbers(const json& j) {
   return n;
 }
 
-double num(const json& f, const char* key) { return f.value(key, 0.0); }
+double num(const json& f, const char* key) {
+  return f.value(key, 0.0);
+}
 
 ColliderShape analytic(const shellmpm::ColliderDesc& c) {
   ColliderShape s;
@@ -162,7 +172,8 @@ ColliderShape analytic(const shellmpm::ColliderDesc& c) {
   s.radius = d.radius;
   s.height = d.height;
   s.axis = d.axis;
-  for (const shellmpm::Keyframe& k : c.keyframes) s.keys.push_back({k.time, k.translate, k.rotate_deg});
+  for (const shellmpm::Keyframe& k : c.keyframes)
+    s.keys.push_back({k.time, k.translate, k.rotate_deg});
   return s;
 }
 
@@ -185,7 +196,8 @@ double highest_potential(const shellmpm::ShapeDesc& d, const V3& g) {
       return up.dot(d.center) + gn * d.radius;
     case K::Cylinder: {
       const double ca = gn > 0 ? std::abs(d.axis.normalized().dot(g / gn)) : 0;
-      return up.dot(d.center) + gn * (0.5 * d.height * ca + d.radius * std::sqrt(std::max(0.0, 1 - ca * ca)));
+      return up.dot(d.center) +
+             gn * (0.5 * d.height * ca + d.radius * std::sqrt(std::max(0.0, 1 - ca * ca)));
     }
     default:
       FAIL("no potential bound for this source shape");
@@ -263,7 +275,8 @@ std::string check_run(const Run& r, const WorkBound& work) {
     surf.emplace_back(r.meshes[0][s], kBandCells * dx, kRimCells * dx, kDeadCells * dx);
   std::vector<std::vector<int>> vertex_ids(ns);
   for (std::size_t s = 0; s < ns; ++s)
-    for (std::size_t v = 0; v < r.meshes[0][s].x.size(); ++v) vertex_ids[s].push_back(static_cast<int>(v));
+    for (std::size_t v = 0; v < r.meshes[0][s].x.size(); ++v)
+      vertex_ids[s].push_back(static_cast<int>(v));
   // Rest mass per triangle, for the shells' potential energy.
   std::vector<std::vector<double>> tri_mass(ns);
   for (std::size_t s = 0; s < ns; ++s) {
@@ -278,31 +291,34 @@ std::string check_run(const Run& r, const WorkBound& work) {
   std::vector<std::string> disagreement_text;
   const auto disagree = [&](int f, const std::string& what) {
     ++disagreements;
-    if (disagreement_text.size() < 6) disagreement_text.push_back("frame " + std::to_string(f) + ": " + what);
+    if (disagreement_text.size() < 6)
+      disagreement_text.push_back("frame " + std::to_string(f) + ": " + what);
   };
 
   // Crossings found: the first few, with where they were, for the summary
   // (SHELLMPM_STRESS_DEBUG: up to 50, each with its samples).
   const bool debug = std::getenv("SHELLMPM_STRESS_DEBUG") != nullptr;
   std::vector<std::string> crossing_text;
-  const auto note_crossing = [&](int f, const std::string& who, const std::string& shell, const V3& x0,
-                                 const SideSample& s0, const V3& x1, const SideSample& s1) {
+  const auto note_crossing = [&](int f, const std::string& who, const std::string& shell,
+                                 const V3& x0, const SideSample& s0, const V3& x1,
+                                 const SideSample& s1) {
     if (crossing_text.size() >= (debug ? 50u : 3u)) return;
     std::ostringstream os;
     os.precision(4);
-    os << "frame " << f << ": " << who << " through " << shell << ", (" << x0.transpose() << ") -> ("
-       << x1.transpose() << ")";
+    os << "frame " << f << ": " << who << " through " << shell << ", (" << x0.transpose()
+       << ") -> (" << x1.transpose() << ")";
     if (debug)
-      os << "; before: side " << s0.sign << " at " << s0.distance / dx << " dx, rest (" << s0.rest.transpose()
-         << "); after: side " << s1.sign << " at " << s1.distance / dx << " dx, rest ("
-         << s1.rest.transpose() << ")";
+      os << "; before: side " << s0.sign << " at " << s0.distance / dx << " dx, rest ("
+         << s0.rest.transpose() << "); after: side " << s1.sign << " at " << s1.distance / dx
+         << " dx, rest (" << s1.rest.transpose() << ")";
     crossing_text.push_back(os.str());
   };
   // Point-frame pairs that had a side in both frames (how much the side test saw).
   std::size_t bulk_judged = 0, point_judged = 0;
   // Samples of the previous frame: bulk vs shell s, shell a's vertices vs shell b.
   std::vector<std::vector<SideSample>> bulk_prev(ns);
-  std::vector<std::vector<std::vector<SideSample>>> pts_prev(ns, std::vector<std::vector<SideSample>>(ns));
+  std::vector<std::vector<std::vector<SideSample>>> pts_prev(
+      ns, std::vector<std::vector<SideSample>>(ns));
 
   std::vector<double> energy(nf), kinetic(nf), potential(nf), emitted_in(nf, 0.0);
   double mass_per_particle = -1;
@@ -322,16 +338,19 @@ std::string check_run(const Run& r, const WorkBound& work) {
     const bool has_monitor = st.contains("integrity") && st["integrity"].is_object();
     CHECK(has_monitor);  // every suite scene has contact shells or colliders
     const json mon = has_monitor ? st["integrity"] : json::object();
-    const double m_self = num(mon, "self_crossing_edges"), m_pair = num(mon, "shell_crossing_edges");
+    const double m_self = num(mon, "self_crossing_edges"),
+                 m_pair = num(mon, "shell_crossing_edges");
     const double m_bulk = num(mon, "bulk_crossings"), m_pts = num(mon, "shell_point_crossings");
-    const double m_pen = num(mon, "collider_penetrations"), m_depth = num(mon, "max_collider_depth");
+    const double m_pen = num(mon, "collider_penetrations"),
+                 m_depth = num(mon, "max_collider_depth");
     const double m_nonfinite = num(mon, "non_finite");
     mon_self.add(m_self, f);
     mon_pair.add(m_pair, f);
     mon_bulk.add(m_bulk, f);
     mon_point.add(m_pts, f);
     mon_depth.add(m_depth / dx, f);
-    if (bad_files > 0 && m_nonfinite == 0) disagree(f, "non-finite values in the caches, monitor 0");
+    if (bad_files > 0 && m_nonfinite == 0)
+      disagree(f, "non-finite values in the caches, monitor 0");
     if (m_nonfinite > 0 && bad_files == 0) disagree(f, "monitor non_finite > 0, caches all finite");
     if (k > 0 && ns > 0 && num(mon, "checks") < 1) disagree(f, "monitor made no side checks");
     // --- shell topology
@@ -355,10 +374,13 @@ std::string check_run(const Run& r, const WorkBound& work) {
     pair_x.add(static_cast<double>(pair_clear), f);
     if (self_clear > 0 && m_self == 0)
       disagree(f, std::to_string(self_clear) + " self-crossing edges, monitor 0");
-    if (m_self > 0 && self_any == 0) disagree(f, "monitor self_crossing_edges " + std::to_string(int(m_self)) + ", independent 0");
+    if (m_self > 0 && self_any == 0)
+      disagree(f, "monitor self_crossing_edges " + std::to_string(int(m_self)) + ", independent 0");
     if (pair_clear > 0 && m_pair == 0)
       disagree(f, std::to_string(pair_clear) + " shell-shell crossing edges, monitor 0");
-    if (m_pair > 0 && pair_any == 0) disagree(f, "monitor shell_crossing_edges " + std::to_string(int(m_pair)) + ", independent 0");
+    if (m_pair > 0 && pair_any == 0)
+      disagree(f,
+               "monitor shell_crossing_edges " + std::to_string(int(m_pair)) + ", independent 0");
     // --- points through shells, between the previous frame and this one
     for (std::size_t s = 0; s < ns; ++s) surf[s].set_frame(r.meshes[k][s]);
     std::size_t bulk_flips = 0, point_flips = 0;
@@ -417,8 +439,10 @@ std::string check_run(const Run& r, const WorkBound& work) {
       if (std::abs(deepest - m_depth) > tol)
         disagree(f, "deepest collider point " + std::to_string(deepest / dx) + " dx, monitor " +
                         std::to_string(m_depth / dx) + " dx");
-      if (deep_clear > 0 && m_pen == 0) disagree(f, std::to_string(deep_clear) + " points inside colliders, monitor 0");
-      if (m_pen > 0 && deep_any == 0) disagree(f, "monitor collider_penetrations > 0, independent 0");
+      if (deep_clear > 0 && m_pen == 0)
+        disagree(f, std::to_string(deep_clear) + " points inside colliders, monitor 0");
+      if (m_pen > 0 && deep_any == 0)
+        disagree(f, "monitor collider_penetrations > 0, independent 0");
     }
     // --- mass and particle count
     const double count = st["particles"].get<double>(), mass = st["mass"].get<double>();
@@ -441,8 +465,8 @@ std::string check_run(const Run& r, const WorkBound& work) {
         if (!emitting) CHECK(p.x.size() == last_count);
         if (emits) emitted_in[k] = emitted_in[k - 1];
         if (emits && p.x.size() > last_count) {
-          const double per = mass_per_particle *
-                             (0.5 * sc.sources[0].velocity.squaredNorm() + highest_potential(sc.sources[0].shape, g));
+          const double per = mass_per_particle * (0.5 * sc.sources[0].velocity.squaredNorm() +
+                                                  highest_potential(sc.sources[0].shape, g));
           emitted_in[k] += (p.x.size() - last_count) * per;
         }
       }
@@ -457,7 +481,8 @@ std::string check_run(const Run& r, const WorkBound& work) {
     for (std::size_t s = 0; s < ns; ++s)
       for (std::size_t tt = 0; tt < tri_mass[s].size(); ++tt) {
         const Eigen::Vector3i& tr = r.meshes[k][s].tri[tt];
-        const V3 c = (r.meshes[k][s].x[tr[0]] + r.meshes[k][s].x[tr[1]] + r.meshes[k][s].x[tr[2]]) / 3;
+        const V3 c =
+            (r.meshes[k][s].x[tr[0]] + r.meshes[k][s].x[tr[1]] + r.meshes[k][s].x[tr[2]]) / 3;
         pe -= tri_mass[s][tt] * g.dot(c);
       }
     kinetic[k] = num(st, "kinetic_energy") + num(st, "shell_kinetic_energy");
@@ -499,14 +524,15 @@ std::string check_run(const Run& r, const WorkBound& work) {
   std::ostringstream os;
   os.precision(3);
   os << "[stress] " << r.name << ": exit " << r.exit_code << ", " << nf << "/" << expected_frames
-     << " frames, " << (nf > 1 ? sim_wall / double(nf - 1) : 0.0) << " s/frame (run " << r.wall_seconds
-     << " s)\n  independent: non-finite " << nonfinite.text() << ", self-crossing edges " << self_x.text()
-     << ", shell-shell edges " << pair_x.text() << ", bulk through shell " << bulk_x.text()
-     << ", shell points through shell " << point_x.text() << ", inside colliders " << depth_count.text()
-     << " (deepest " << depth.text(" dx") << "); judged " << bulk_judged << " particle and "
-     << point_judged << " shell point steps near a shell\n  monitor: self " << mon_self.text() << ", shell-shell "
-     << mon_pair.text() << ", bulk " << mon_bulk.text() << ", points " << mon_point.text() << ", deepest "
-     << mon_depth.text(" dx") << "; disagreements " << disagreements;
+     << " frames, " << (nf > 1 ? sim_wall / double(nf - 1) : 0.0) << " s/frame (run "
+     << r.wall_seconds << " s)\n  independent: non-finite " << nonfinite.text()
+     << ", self-crossing edges " << self_x.text() << ", shell-shell edges " << pair_x.text()
+     << ", bulk through shell " << bulk_x.text() << ", shell points through shell "
+     << point_x.text() << ", inside colliders " << depth_count.text() << " (deepest "
+     << depth.text(" dx") << "); judged " << bulk_judged << " particle and " << point_judged
+     << " shell point steps near a shell\n  monitor: self " << mon_self.text() << ", shell-shell "
+     << mon_pair.text() << ", bulk " << mon_bulk.text() << ", points " << mon_point.text()
+     << ", deepest " << mon_depth.text(" dx") << "; disagreements " << disagreements;
   for (const std::string& d : disagreement_text) os << "\n    " << d;
   for (const std::string& c : crossing_text) os << "\n  crossing: " << c;
   os << "\n  energy: start " << energy[0] << " J, end " << energy[nf - 1] << " J, input bound "
@@ -735,7 +761,8 @@ TEST_CASE("stress: irregular mesh shell with slivers, valence 3 and 12", "[stres
     // The sheet lands on the sphere: at the end some point is within a cell of it.
     const ColliderShape ball = analytic(r.scene.colliders[0]);
     double closest = 1e300;
-    for (const V3& x : r.meshes.back()[0].x) closest = std::min(closest, collider_distance(ball, x, r.time(r.frames.size() - 1)));
+    for (const V3& x : r.meshes.back()[0].x)
+      closest = std::min(closest, collider_distance(ball, x, r.time(r.frames.size() - 1)));
     CHECK(closest < r.scene.shot.dx);
   });
 }

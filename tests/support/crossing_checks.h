@@ -57,7 +57,7 @@ inline Crossing segment_triangle(const V3& p, const V3& q, const V3& a, const V3
   const double n = (b - a).cross(c - a).norm();
   if (dp == dq || std::max(std::abs(dp), std::abs(dq)) <= 1e-9 * n * (q - p).norm())
     return Crossing::None;
-  const double t = dp / (dp - dq);      // where the line meets the plane
+  const double t = dp / (dp - dq);  // where the line meets the plane
   if (t < -eps || t > 1 + eps) return Crossing::None;
   const double s1 = detail::orient(p, q, a, b), s2 = detail::orient(p, q, b, c),
                s3 = detail::orient(p, q, c, a);
@@ -121,8 +121,8 @@ inline void edges_through(const TriMesh& em, const TriMesh& tm, bool self, EdgeC
     Crossing worst = Crossing::None;
     for (std::size_t t = 0; t < tm.tri.size() && worst != Crossing::Clear; ++t) {
       const Eigen::Vector3i& tr = tm.tri[t];
-      if (self && (tr[0] == e.first || tr[1] == e.first || tr[2] == e.first ||
-                   tr[0] == e.second || tr[1] == e.second || tr[2] == e.second))
+      if (self && (tr[0] == e.first || tr[1] == e.first || tr[2] == e.first || tr[0] == e.second ||
+                   tr[1] == e.second || tr[2] == e.second))
         continue;
       if (!eb.overlaps(boxes[t])) continue;
       const Crossing c = segment_triangle(p, q, tm.x[tr[0]], tm.x[tr[1]], tm.x[tr[2]]);
@@ -189,9 +189,9 @@ inline V3 closest_barycentric(const V3& x, const V3& a, const V3& b, const V3& c
 /// Where a point is relative to one shell's surface in one frame.
 struct SideSample {
   enum class State { Far, Rim, Dead, Side } state = State::Far;
-  int sign = 0;           ///< +1 on the normal's side, -1 behind (State::Side only)
-  double distance = 0;    ///< to the closest point [m]
-  V3 rest{0, 0, 0};       ///< the closest point, mapped to the rest mesh [m]
+  int sign = 0;         ///< +1 on the normal's side, -1 behind (State::Side only)
+  double distance = 0;  ///< to the closest point [m]
+  V3 rest{0, 0, 0};     ///< the closest point, mapped to the rest mesh [m]
 };
 
 /// A shell's surface: its rest mesh (frame 1) for the boundary and for locality, and the
@@ -393,7 +393,8 @@ inline std::pair<Eigen::Matrix3d, V3> pose_at(const std::vector<PoseKey>& keys, 
   const PoseKey& a = keys[k - 1];
   const PoseKey& b = keys[k];
   const double s = (t - a.time) / (b.time - a.time);
-  const Eigen::Quaterniond q = detail::euler_xyz(a.rotate_deg).slerp(s, detail::euler_xyz(b.rotate_deg));
+  const Eigen::Quaterniond q =
+      detail::euler_xyz(a.rotate_deg).slerp(s, detail::euler_xyz(b.rotate_deg));
   return {q.toRotationMatrix(), (1 - s) * a.translate + s * b.translate};
 }
 

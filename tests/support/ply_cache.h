@@ -44,8 +44,7 @@ struct PlyElement {
 inline int ply_type_size(const std::string& t) {
   if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
   if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" ||
-      t == "float32")
+  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32")
     return 4;
   if (t == "double" || t == "float64") return 8;
   throw std::runtime_error("PLY: unknown property type '" + t + "'");
@@ -155,7 +154,8 @@ inline TriMesh read_mesh_ply(const std::string& path) {
           if (e.name == "face") {
             if (n != 3) throw std::runtime_error(path + ": a face that is not a triangle");
             Eigen::Vector3i t;
-            for (int k = 0; k < 3; ++k) t[k] = static_cast<int>(detail::ply_value(p.type, &b[off + k * vs]));
+            for (int k = 0; k < 3; ++k)
+              t[k] = static_cast<int>(detail::ply_value(p.type, &b[off + k * vs]));
             m.tri.push_back(t);
           }
           off += std::size_t(n) * vs;

@@ -95,7 +95,8 @@ TEST_CASE("crossing checks: a point that jumps through a shell is counted", "[st
   const TriMesh rest = sheet(10, 1.0, 0.0);
   const ShellSurface surf(rest, 2 * dx, 2 * dx, 1e-3 * dx);
   const std::vector<int> ids = {7};
-  const auto flips = [&](const ShellSurface& s0, const ShellSurface& s1, const V3& p0, const V3& p1) {
+  const auto flips = [&](const ShellSurface& s0, const ShellSurface& s1, const V3& p0,
+                         const V3& p1) {
     return count_crossings(s0, s1, std::vector<V3>{p0}, ids, std::vector<V3>{p1}, ids, 4 * dx);
   };
   // Straight through the middle, between two frames.
@@ -154,7 +155,8 @@ TEST_CASE("crossing checks: collider depth from the analytic shape at the frame'
   box.keys = {{0.0, V3(1, 0, 0), V3(0, 0, 45)}};
   CHECK(collider_distance(box, V3(1, 0, 0), 0.0) == Approx(-0.1));
   // 0.1 along the box's diagonal: 0.1 / sqrt 2 along each local axis, inside.
-  CHECK(collider_distance(box, V3(1.1, 0, 0), 0.0) == Approx(0.1 / std::sqrt(2.0) - 0.1).margin(1e-12));
+  CHECK(collider_distance(box, V3(1.1, 0, 0), 0.0) ==
+        Approx(0.1 / std::sqrt(2.0) - 0.1).margin(1e-12));
   ColliderShape ball;
   ball.kind = ColliderShape::Kind::Sphere;
   ball.center = V3(0, -0.2, 0);
