@@ -644,6 +644,19 @@ TEST_CASE("stress: strip twisted 3.5 relative turns (tight self-contact)", "[str
       });
 }
 
+TEST_CASE("stress: a strip wrung by four relative turns", "[stress]") {
+  stress_case(
+      "strip_twist_4turns",
+      [](const Run& r) {
+        // As for three turns: the strip at a uniform 0.5 Hencky strain in every direction,
+        // plus twice the pinned ends' kinetic energy at their fastest (1.3 m/s).
+        const double A = rest_area(r, 0), m = shell_mass(r, 0);
+        return WorkBound{membrane_bound(r.scene, 0, A, 0.5) + 2 * m * 1.3 * 1.3,
+                         "strip at equibiaxial strain 0.5 plus 2 m v_pin^2"};
+      },
+      [](const Run& r) { CHECK(stats_max(r, "contact_compressed") > 0); });
+}
+
 TEST_CASE("stress: box blade at 10 m/s through a sand pile on the ground", "[stress]") {
   stress_case(
       "blade_sand_pile",
