@@ -145,6 +145,7 @@ IntegrityMonitor::Hit IntegrityMonitor::side_of(const Vec3d& x, int exclude) con
 }
 
 void IntegrityMonitor::compare(const IntegrityView& view, bool record_only) {
+  if (shells_.empty()) return;  // nothing to cross: no side records (no memory per particle)
   refresh(view);
   const std::size_t nv = vertex_offset_.back();
   const std::size_t nb = view.bulk ? view.bulk->size() : 0;
@@ -156,7 +157,6 @@ void IntegrityMonitor::compare(const IntegrityView& view, bool record_only) {
     rec_shell_.resize(n, -1);  // particles emitted since the last check
     rec_side_.resize(n, 0);
   }
-  if (shells_.empty()) return;
   ++checks_;
   const std::size_t K = shells_.size();
   const std::size_t chunks = (n + kGrain - 1) / kGrain;
