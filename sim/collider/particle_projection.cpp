@@ -64,8 +64,8 @@ int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr,
 
 }  // namespace
 
-ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders, double dx, double dt,
-                                         std::vector<Vec3>& x, std::vector<Vec3>& v,
+ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders, double dx,
+                                         double dt, std::vector<Vec3>& x, std::vector<Vec3>& v,
                                          const std::vector<std::uint8_t>* held, bool serial) {
   ProjectionStats total;
   if (colliders.empty() || x.empty()) return total;

@@ -31,8 +31,8 @@ struct ProjectionStats {
 /// Projects points x (velocities v, advected over dt with x += dt v) out of the colliders
 /// (their begin_step set for this step). held: per point, components a pin prescribes
 /// (bit a; may be null): such points are left alone.
-ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders, double dx, double dt,
-                                         std::vector<Vec3>& x, std::vector<Vec3>& v,
+ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders, double dx,
+                                         double dt, std::vector<Vec3>& x, std::vector<Vec3>& v,
                                          const std::vector<std::uint8_t>* held, bool serial);
 
 }  // namespace shellmpm

@@ -73,8 +73,8 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
             const Mat3 A = (m * dx) * gs.contact->C[j];
             const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
             const Vec3 base = m * sh.v[j] + dt * gs.force[j] - A * fx;
-          const Vec3& nj = F.normal[j];
-          const Real mh = gs.held[j] == 7 ? m : Real(0);
+            const Vec3& nj = F.normal[j];
+            const Real mh = gs.held[j] == 7 ? m : Real(0);
             const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
             for (int i = 0; i < 3; ++i)
               for (int jj = 0; jj < 3; ++jj)
@@ -289,7 +289,8 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
                 } else {
                   continue;
                 }
-                contact_pair(nab, std::sqrt(friction_[a] * friction_[b]), winv[a], vel[a], winv[b], vel[b]);
+                contact_pair(nab, std::sqrt(friction_[a] * friction_[b]), winv[a], vel[a], winv[b],
+                             vel[b]);
               }
             if (bulk) {
               // Which side of a shell the bulk material is on: where its mass centroid lies

@@ -29,8 +29,8 @@ struct Tally {
   }
 };
 
-void merge(const std::vector<Tally>& parts, std::vector<std::size_t>& count, std::vector<Vec3d>& where,
-           std::vector<int>* from) {
+void merge(const std::vector<Tally>& parts, std::vector<std::size_t>& count,
+           std::vector<Vec3d>& where, std::vector<int>* from) {
   for (const Tally& t : parts)
     for (std::size_t s = 0; s < count.size(); ++s) {
       if (t.count[s] == 0) continue;
@@ -52,7 +52,8 @@ void IntegrityMonitor::setup(const IntegrityView& view, double dx) {
   vertex_offset_.assign(1, 0);
   for (const ShellObject* sh : view.shells) {
     ShellGeom g;
-    g.limit = std::make_unique<LimitMesh>(sh->basis(), sh->triangles(), std::vector<Eigen::Vector2d>{}, 0);
+    g.limit = std::make_unique<LimitMesh>(sh->basis(), sh->triangles(),
+                                          std::vector<Eigen::Vector2d>{}, 0);
     const auto& T = g.limit->triangles();
     std::map<std::pair<int, int>, int> uses;
     for (const Eigen::Vector3i& t : T)
@@ -76,8 +77,7 @@ void IntegrityMonitor::setup(const IntegrityView& view, double dx) {
     boundary.erase(std::unique(boundary.begin(), boundary.end()), boundary.end());
     g.rim.assign(rp.size(), std::numeric_limits<double>::infinity());
     for (std::size_t v = 0; v < rp.size(); ++v)
-      for (int b : boundary)
-        g.rim[v] = std::min(g.rim[v], (rp[v] - rp[b]).cast<double>().norm());
+      for (int b : boundary) g.rim[v] = std::min(g.rim[v], (rp[v] - rp[b]).cast<double>().norm());
     vertex_offset_.push_back(vertex_offset_.back() + rp.size());
     shells_.push_back(std::move(g));
     names_.push_back(sh->name());
@@ -133,7 +133,8 @@ IntegrityMonitor::Hit IntegrityMonitor::side_of(const Vec3d& x, int exclude) con
   if (best.shell < 0) return best;  // Far
   const ShellGeom& g = shells_[best.shell];
   const Eigen::Vector3i& tri = g.limit->triangles()[best_t];
-  const double rim = best_b[0] * g.rim[tri[0]] + best_b[1] * g.rim[tri[1]] + best_b[2] * g.rim[tri[2]];
+  const double rim =
+      best_b[0] * g.rim[tri[0]] + best_b[1] * g.rim[tri[1]] + best_b[2] * g.rim[tri[2]];
   if (rim < kRimCells * dx_) {
     best.side = Side::Rim;
     return best;
@@ -274,7 +275,8 @@ void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityRepo
     for (std::size_t s = 0; s < shells_.size(); ++s) {
       const ShellObject& sh = *view.shells[s];
       std::size_t b = 0;
-      for (std::size_t j = 0; j < sh.size(); ++j) b += !(sh.x[j].allFinite() && sh.v[j].allFinite());
+      for (std::size_t j = 0; j < sh.size(); ++j)
+        b += !(sh.x[j].allFinite() && sh.v[j].allFinite());
       if (!b) continue;
       IntegrityEvent e;
       e.kind = IntegrityEvent::Kind::NonFinite;
@@ -313,7 +315,8 @@ void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityRepo
                   if (self && (tri[0] == u || tri[1] == u || tri[2] == u || tri[0] == v ||
                                tri[1] == v || tri[2] == v))
                     continue;
-                  if (segment_crosses_triangle(p, q, tb.pos[tri[0]], tb.pos[tri[1]], tb.pos[tri[2]])) {
+                  if (segment_crosses_triangle(p, q, tb.pos[tri[0]], tb.pos[tri[1]],
+                                               tb.pos[tri[2]])) {
                     tl.add(0, 0.5 * (p + q), -1);
                     break;
                   }

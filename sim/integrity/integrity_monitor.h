@@ -77,7 +77,9 @@ class IntegrityMonitor {
   Hit side_of(const Vec3d& x, int exclude) const;
   void compare(const IntegrityView& view, bool record_only);
   void frame_end_checks(const IntegrityView& view, IntegrityReport& r) const;
-  const std::vector<Eigen::Vector3i>& tris(std::size_t s) const { return shells_[s].limit->triangles(); }
+  const std::vector<Eigen::Vector3i>& tris(std::size_t s) const {
+    return shells_[s].limit->triangles();
+  }
 
   bool active_ = false;
   double dx_ = 0, band_ = 0;

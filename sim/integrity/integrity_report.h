@@ -22,14 +22,14 @@ struct IntegrityEvent {
   std::string object;  ///< the shell or collider concerned
   std::string other;   ///< the other shell, if any
   std::size_t count = 0;
-  double value = 0;    ///< InsideCollider: deepest penetration [m]
+  double value = 0;      ///< InsideCollider: deepest penetration [m]
   Vec3d where{0, 0, 0};  ///< a place where it happened (first crossing, deepest point)
 };
 
 /// One frame's integrity counts (all zero when nothing went wrong).
 struct IntegrityReport {
-  bool active = false;  ///< false: the scene has nothing the monitor checks
-  int checks = 0;       ///< side checks made during the frame
+  bool active = false;                    ///< false: the scene has nothing the monitor checks
+  int checks = 0;                         ///< side checks made during the frame
   std::size_t bulk_crossings = 0;         ///< bulk particles that crossed a shell
   std::size_t shell_point_crossings = 0;  ///< shell points that crossed another shell
   std::size_t shell_crossing_edges = 0;   ///< edges through another shell at frame end

@@ -82,7 +82,8 @@ void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen:
     const Vec3i c0 = cell_of(lo.array() - pad), c1 = cell_of(hi.array() + pad);
     for (int i = c0[0]; i <= c1[0]; ++i)
       for (int j = c0[1]; j <= c1[1]; ++j)
-        for (int k = c0[2]; k <= c1[2]; ++k) pairs.emplace_back(key(Vec3i(i, j, k)), static_cast<int>(t));
+        for (int k = c0[2]; k <= c1[2]; ++k)
+          pairs.emplace_back(key(Vec3i(i, j, k)), static_cast<int>(t));
   }
   std::sort(pairs.begin(), pairs.end());
   keys_.resize(pairs.size());

@@ -18,7 +18,8 @@ std::string scene(const TempDir& d, const std::string& mode) {
 shot:
   frames: [1, 3]
   dx: 0.04
-  on_integrity_failure: )") + mode + R"(
+  on_integrity_failure: )") +
+                           mode + R"(
   domain: {min: [-0.5, 0, -0.5], max: [0.5, 1, 0.5]}
 materials:
   - {name: jelly, type: elastic, youngs_modulus: 1.0e4, poisson_ratio: 0.3, density: 1000}
@@ -27,7 +28,8 @@ sources:
 colliders:
   - {name: slab, shape: {type: box, min: [-0.3, 0.0, -0.3], max: [0.3, 0.3, 0.3]}}
 output:
-  directory: )" + d.file("out") + "\n";
+  directory: )" + d.file("out") +
+                           "\n";
   return d.write("scene.yaml", text);
 }
 

@@ -47,11 +47,12 @@ TEST_CASE("a point inside a moving blade is put on its surface and moves with it
   CHECK(st.inside == 1);
   CHECK(cs[0].phi(x[0].cast<double>()) > -1e-6);
   CHECK(x[0].x() == Approx(0.515).margin(1e-5));
-  CHECK(x[0].x() >= 0.515f);  // the blade's +x face
-  CHECK(v[0].x() == Approx(10.0).epsilon(1e-3));   // no normal velocity into the blade
+  CHECK(x[0].x() >= 0.515f);                      // the blade's +x face
+  CHECK(v[0].x() == Approx(10.0).epsilon(1e-3));  // no normal velocity into the blade
 }
 
-TEST_CASE("a thin blade that passes over a point in one step sends it back to the front", "[collider]") {
+TEST_CASE("a thin blade that passes over a point in one step sends it back to the front",
+          "[collider]") {
   // 100 m/s: the blade moves 0.1 m = 5 dx in the step, far more than its thickness.
   std::vector<Collider> cs{Collider(blade(-0.05, 0.95, 0.01))};
   const double dt = 1e-3, dx = 0.02;

@@ -124,8 +124,8 @@ TEST_CASE("the monitor reports points deeper than half a cell inside a collider,
   g.shape.normal = Vec3d(0, 1, 0);
   std::vector<Collider> colliders{Collider(g)};
   ParticleSet bulk;
-  bulk.push_back(Vec3(0, -0.004f, 0), Vec3::Zero(), 1e-6f, 0, 1);   // 0.2 dx: tolerated
-  bulk.push_back(Vec3(0, -0.016f, 0), Vec3::Zero(), 1e-6f, 0, 1);   // 0.8 dx
+  bulk.push_back(Vec3(0, -0.004f, 0), Vec3::Zero(), 1e-6f, 0, 1);  // 0.2 dx: tolerated
+  bulk.push_back(Vec3(0, -0.016f, 0), Vec3::Zero(), 1e-6f, 0, 1);  // 0.8 dx
   bulk.push_back(Vec3(0.1f, 0.1f, 0), Vec3::Zero(), 1e-6f, 0, 1);
   IntegrityView view;
   view.bulk = &bulk;
