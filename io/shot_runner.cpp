@@ -122,11 +122,12 @@ int run_shot(const Scene& scene, const RunOptions& opt) {
       });
     }
     fs.frame = frame;
-    if (fs.integrity.failed()) {
+    if (!fs.integrity.events.empty()) {
       const std::vector<std::string> lines = describe_integrity(fs.integrity, frame, shot.dx);
       for (const std::string& l : lines)
         if (opt.warn) opt.warn(l);
-      if (shot.on_integrity_failure == ShotSettings::OnIntegrityFailure::Stop) {
+      if (fs.integrity.failed() &&
+          shot.on_integrity_failure == ShotSettings::OnIntegrityFailure::Stop) {
         // The frame's statistics are kept; its caches are not written (wrong physics).
         stats.add(fs);
         stats.write();

@@ -46,16 +46,20 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     in["max_collider_depth"] = r.max_collider_depth;
     in["collider_depth_limit"] = r.collider_limit;
     in["non_finite"] = r.non_finite;
+    in["stretched_edges"] = r.stretched_edges;
+    in["max_edge"] = r.max_edge;
     nlohmann::json ev = nlohmann::json::array();
     for (const IntegrityEvent& e : r.events) {
       static const char* kinds[] = {"bulk_through_shell", "shell_through_shell", "shells_intersect",
-                                    "self_intersect",     "inside_collider",     "non_finite"};
+                                    "self_intersect",     "inside_collider",     "non_finite",
+                                    "stretched_mesh"};
       nlohmann::json je;
       je["kind"] = kinds[static_cast<int>(e.kind)];
       je["object"] = e.object;
       if (!e.other.empty()) je["other"] = e.other;
       je["count"] = e.count;
       if (e.kind == IntegrityEvent::Kind::InsideCollider) je["depth"] = e.value;
+      if (e.kind == IntegrityEvent::Kind::StretchedMesh) je["longest_edge"] = e.value;
       je["where"] = {e.where.x(), e.where.y(), e.where.z()};
       ev.push_back(je);
     }

@@ -14,6 +14,7 @@ constexpr std::size_t kGrain = 2048;
 constexpr double kRimCells = 2.0;    ///< points this close to a boundary (rest) are not judged
 constexpr double kDeadCells = 1e-3;  ///< points this close to the surface have no side
 constexpr double kColliderCells = 0.5;
+constexpr double kStretchedCells = 2.0;  ///< contact-shell edges longer than this warn
 
 // Per-chunk tallies, combined in chunk order (deterministic).
 struct Tally {
@@ -257,6 +258,7 @@ IntegrityReport IntegrityMonitor::snapshot(const IntegrityView& view) {
 
 void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityReport& r) const {
   r.active = true;
+  std::vector<IntegrityEvent> warnings;
   r.collider_limit = kColliderCells * dx_;
   const std::size_t nb = view.bulk ? view.bulk->size() : 0;
   // Non-finite state.
@@ -339,6 +341,32 @@ void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityRepo
       r.events.push_back(e);
       (a == b ? r.self_crossing_edges : r.shell_crossing_edges) += count;
     }
+  // Stretched meshes: a contact shell whose edges grew past 2 dx leaves gaps between its
+  // control points' kernels, through which contact can leak (a warning, not a failure).
+  for (std::size_t s = 0; s < K; ++s) {
+    const ShellGeom& g = shells_[s];
+    std::size_t longer = 0;
+    double longest = 0;
+    Vec3d where = Vec3d::Zero();
+    for (const auto& [u, v] : g.edges) {
+      const double l = (g.pos[u] - g.pos[v]).norm();
+      if (l > kStretchedCells * dx_) ++longer;
+      if (l > longest) {
+        longest = l;
+        where = 0.5 * (g.pos[u] + g.pos[v]);
+      }
+    }
+    r.max_edge = std::max(r.max_edge, longest);
+    if (!longer) continue;
+    IntegrityEvent e;
+    e.kind = IntegrityEvent::Kind::StretchedMesh;
+    e.object = names_[s];
+    e.count = longer;
+    e.value = longest;
+    e.where = where;
+    warnings.push_back(e);
+    r.stretched_edges += longer;
+  }
   // Colliders: bulk particles and shell limit vertices deeper than the limit.
   if (view.colliders)
     for (const Collider& c : *view.colliders) {
@@ -395,6 +423,7 @@ void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityRepo
       r.events.push_back(e);
       r.collider_penetrations += total.count;
     }
+  r.events.insert(r.events.end(), warnings.begin(), warnings.end());
 }
 
 }  // namespace shellmpm

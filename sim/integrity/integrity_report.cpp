@@ -39,6 +39,11 @@ std::vector<std::string> describe_integrity(const IntegrityReport& r, int frame,
       case IntegrityEvent::Kind::NonFinite:
         os << e.count << " non-finite positions or velocities in " << e.object;
         break;
+      case IntegrityEvent::Kind::StretchedMesh:
+        os << "shell '" << e.object << "' has " << e.count << " edges longer than 2 dx (longest "
+           << e.value / dx << " dx): contact can leak between its control points; refine the "
+           << "mesh or raise dx";
+        break;
     }
     out.push_back(os.str());
   }

@@ -17,6 +17,8 @@ struct IntegrityEvent {
     SelfIntersect,      ///< edges of `object` pass through its own triangles (frame end)
     InsideCollider,     ///< points deeper than the limit inside collider `object`
     NonFinite,          ///< non-finite positions or velocities (`object`: bulk or a shell)
+    StretchedMesh,      ///< a warning, not a failure: edges of shell `object` longer than
+                        ///< 2 dx, where contact can leak between its control points
   };
   Kind kind = Kind::BulkThroughShell;
   std::string object;  ///< the shell or collider concerned
@@ -38,7 +40,9 @@ struct IntegrityReport {
   double max_collider_depth = 0;          ///< deepest point inside any collider [m]
   double collider_limit = 0;              ///< the depth limit used (0.5 dx) [m]
   std::size_t non_finite = 0;             ///< non-finite positions or velocities
-  std::vector<IntegrityEvent> events;
+  std::size_t stretched_edges = 0;        ///< contact-shell edges longer than 2 dx (a warning)
+  double max_edge = 0;                    ///< longest contact-shell limit-mesh edge [m]
+  std::vector<IntegrityEvent> events;     ///< failures, then warnings
 
   bool failed() const {
     return bulk_crossings + shell_point_crossings + shell_crossing_edges + self_crossing_edges +

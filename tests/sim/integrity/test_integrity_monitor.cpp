@@ -141,3 +141,25 @@ TEST_CASE("the monitor reports points deeper than half a cell inside a collider,
   r = mon.snapshot(view);
   CHECK(r.non_finite == 1);
 }
+
+TEST_CASE("a contact shell stretched past 2 dx per edge is a warning, not a failure",
+          "[integrity]") {
+  auto sheet = flat_sheet("curtain", 0.4, 20, 0.0);  // 2 cm edges: 1 dx
+  IntegrityView view;
+  view.shells = {sheet.get()};
+  IntegrityMonitor mon;
+  mon.setup(view, kDx);
+  IntegrityReport r = mon.snapshot(view);
+  CHECK(r.stretched_edges == 0);
+  CHECK(r.max_edge == Approx(0.02 * std::sqrt(2.0)).epsilon(0.05));  // the diagonals
+  for (Vec3& x : sheet->x) x.x() *= 2.5f;                            // edges along x now 2.5 dx
+  r = mon.snapshot(view);
+  CHECK(r.stretched_edges > 0);
+  CHECK(r.max_edge > 2.4 * kDx);
+  CHECK_FALSE(r.failed());
+  REQUIRE(r.events.size() == 1);
+  CHECK(r.events[0].kind == IntegrityEvent::Kind::StretchedMesh);
+  const std::vector<std::string> lines = describe_integrity(r, 7, kDx);
+  CHECK(lines[0].find("frame 7: shell 'curtain' has ") == 0);
+  CHECK(lines[0].find("edges longer than 2 dx") != std::string::npos);
+}
