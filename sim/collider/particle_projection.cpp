@@ -30,7 +30,8 @@ Vec3 resolve_velocity(const Collider& c, const Vec3d& x, const Vec3d& n, const V
 // One point against one collider; returns 1 if moved out from inside, 2 if swept.
 int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr, Vec3& v) {
   const Vec3d x = xr.cast<double>();
-  const Vec3d x0 = c.end_of(x - dt * v.cast<double>());  // the start, in the end pose's frame
+  const Vec3d start = x - dt * v.cast<double>();
+  const Vec3d x0 = c.animated() ? c.end_of(start) : start;  // the start, in the end pose's frame
   const double len = (x - x0).norm();
   Aabb box;
   box.lo = x.cwiseMin(x0).array() - dx;
@@ -77,11 +78,14 @@ ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders,
         ProjectionStats& st = part[b / kGrain];
         for (std::size_t i = b; i < e; ++i) {
           if (held && (*held)[i]) continue;
-          for (int pass = 0; pass < 2; ++pass)
+          // The second pass only for points the first one moved.
+          bool moved = false;
+          for (int pass = 0; pass < 2 && (pass == 0 || moved); ++pass)
             for (const Collider& c : colliders) {
               const int r = project_point(c, dx, dt, pass == 0, x[i], v[i]);
               st.inside += r == 1;
               st.swept += r == 2;
+              moved = moved || r != 0;
             }
         }
       },

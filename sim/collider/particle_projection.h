@@ -11,9 +11,9 @@
 //   from;
 // and its velocity loses the normal relative velocity towards the collider (sticky: the
 // collider's velocity; Coulomb friction on the tangential part as on the grid).
-// Two passes over the colliders, so a point pushed out of one into another (a blade on
-// the ground) is resolved against both (the second pass without the sweep: the velocity
-// has changed, so x - dt v is no longer where the point started).
+// A second pass over the colliders for the points the first one moved, so a point pushed
+// out of one into another (a blade on the ground) is resolved against both; without the
+// sweep, since the velocity has changed and x - dt v is no longer where the point started.
 #pragma once
 #include <cstdint>
 #include <vector>
