@@ -90,23 +90,23 @@ double Collider::max_speed(double t) const {
 bool Collider::apply(const Vec3d& x, Vec3& v) const {
   const Vec3d xl = end_.apply_inverse(x);
   if (shape_phi(desc_.shape, xl) > 0) return false;
+  v = resolve(x, end_.R * shape_normal(desc_.shape, xl), v);
+  return true;
+}
+
+Vec3 Collider::resolve(const Vec3d& x, const Vec3d& n, const Vec3& v) const {
   const Vec3d vc = velocity(x);
-  if (desc_.boundary == BoundaryKind::Sticky) {
-    v = vc.cast<Real>();
-    return true;
-  }
-  const Vec3d n = end_.R * shape_normal(desc_.shape, xl);
-  Vec3d vr = v.cast<double>() - vc;
+  if (desc_.boundary == BoundaryKind::Sticky) return vc.cast<Real>();
+  const Vec3d vr = v.cast<double>() - vc;
   const double vn = vr.dot(n);
-  if (desc_.boundary == BoundaryKind::Separate && vn >= 0) return true;
+  if (desc_.boundary == BoundaryKind::Separate && vn >= 0) return v;
   Vec3d vt = vr - vn * n;
   if (vn < 0 && desc_.friction > 0) {
     const double tn = vt.norm();
     const double drop = -desc_.friction * vn;
     vt = tn <= drop ? Vec3d::Zero() : Vec3d(vt * (1 - drop / tn));
   }
-  v = (vc + vt).cast<Real>();
-  return true;
+  return (vc + vt).cast<Real>();
 }
 
 }  // namespace shellmpm

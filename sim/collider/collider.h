@@ -42,6 +42,10 @@ class Collider {
   const Aabb& bounds() const { return bounds_; }
   /// Applies the boundary condition to a node velocity at world x; true if in contact.
   bool apply(const Vec3d& x, Vec3& v) const;
+  /// The boundary condition on a velocity v at world x in contact, n the outward unit
+  /// normal there: sticky takes the collider's velocity; slip and separate (when
+  /// approaching) drop the relative normal velocity, with Coulomb friction on the rest.
+  Vec3 resolve(const Vec3d& x, const Vec3d& n, const Vec3& v) const;
   bool animated() const { return desc_.keyframes.size() > 1; }
   /// Largest speed of the collider's points at time t [m/s] (for the CFL bound); planes
   /// count their reference point only.

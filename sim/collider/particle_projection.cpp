@@ -10,23 +10,6 @@ namespace {
 
 constexpr std::size_t kGrain = 4096;
 
-// The collider's boundary condition on a point velocity at world x (normal n).
-Vec3 resolve_velocity(const Collider& c, const Vec3d& x, const Vec3d& n, const Vec3& v) {
-  const Vec3d vc = c.velocity(x);
-  if (c.desc().boundary == BoundaryKind::Sticky) return vc.cast<Real>();
-  const Vec3d vr = v.cast<double>() - vc;
-  const double vn = vr.dot(n);
-  if (vn >= 0 && c.desc().boundary == BoundaryKind::Separate) return v;
-  Vec3d vt = vr - vn * n;
-  if (vn < 0 && c.desc().friction > 0) {
-    const double tn = vt.norm();
-    const double drop = -c.desc().friction * vn;
-    vt = tn <= drop ? Vec3d::Zero() : Vec3d(vt * (1 - drop / tn));
-  }
-  const double keep = c.desc().boundary == BoundaryKind::Separate ? std::max(vn, 0.0) : 0.0;
-  return (vc + vt + keep * n).cast<Real>();
-}
-
 // One point against one collider; returns 1 if moved out from inside, 2 if swept.
 int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr, Vec3& v) {
   const Vec3d x = xr.cast<double>();
@@ -43,7 +26,7 @@ int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr,
     const Vec3d n = c.normal(x);
     const Vec3d y = x + (1e-4 * dx - phi) * n;
     xr = y.cast<Real>();
-    v = resolve_velocity(c, y, n, v);
+    v = c.resolve(y, n, v);
     return 1;
   }
   const int samples = sweep ? static_cast<int>(std::ceil(len / (0.5 * dx))) : 0;
@@ -55,7 +38,7 @@ int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr,
     if (c.phi(y) < 0) {
       const Vec3d n = c.normal(last);
       xr = last.cast<Real>();
-      v = resolve_velocity(c, last, n, v);
+      v = c.resolve(last, n, v);
       return 2;
     }
     last = y;

@@ -104,6 +104,13 @@ void IntegrityMonitor::refresh(const IntegrityView& view) {
   }
 }
 
+Vec3d IntegrityMonitor::point(const IntegrityView& view, std::size_t i, std::size_t& s) const {
+  const std::size_t nv = vertex_offset_.back();
+  if (i >= nv) return view.bulk->x[i - nv].cast<double>();
+  while (vertex_offset_[s + 1] <= i) ++s;
+  return shells_[s].pos[i - vertex_offset_[s]];
+}
+
 IntegrityMonitor::Hit IntegrityMonitor::side_of(const Vec3d& x, int exclude) const {
   thread_local std::vector<int> cand;
   Hit best;
@@ -170,15 +177,8 @@ void IntegrityMonitor::compare(const IntegrityView& view, bool record_only) {
         Tally& tp = pts[b / kGrain];
         std::size_t s = 0;
         for (std::size_t i = b; i < e; ++i) {
-          Vec3d x;
-          int own = -1;
-          if (i < nv) {
-            while (vertex_offset_[s + 1] <= i) ++s;
-            own = static_cast<int>(s);
-            x = shells_[s].pos[i - vertex_offset_[s]];
-          } else {
-            x = view.bulk->x[i - nv].cast<double>();
-          }
+          const Vec3d x = point(view, i, s);
+          const int own = i < nv ? static_cast<int>(s) : -1;
           const Hit h = side_of(x, own);
           if (h.side == Side::Far || h.side == Side::Rim) {
             rec_shell_[i] = -1;
@@ -385,13 +385,7 @@ void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityRepo
             Deep& d = parts[b / kGrain];
             std::size_t s = 0;
             for (std::size_t i = b; i < e; ++i) {
-              Vec3d x;
-              if (i < nv) {
-                while (vertex_offset_[s + 1] <= i) ++s;
-                x = shells_[s].pos[i - vertex_offset_[s]];
-              } else {
-                x = view.bulk->x[i - nv].cast<double>();
-              }
+              const Vec3d x = point(view, i, s);
               Aabb at;
               at.lo = at.hi = x;
               if (!x.allFinite() || !c.bounds().overlaps(at)) continue;

@@ -75,6 +75,9 @@ class IntegrityMonitor {
   };
   void refresh(const IntegrityView& view);
   Hit side_of(const Vec3d& x, int exclude) const;
+  /// Tracked point i: shell limit vertices first (s: the shell, advanced from its value
+  /// as i grows), then the bulk particles.
+  Vec3d point(const IntegrityView& view, std::size_t i, std::size_t& s) const;
   void compare(const IntegrityView& view, bool record_only);
   void frame_end_checks(const IntegrityView& view, IntegrityReport& r) const;
   const std::vector<Eigen::Vector3i>& tris(std::size_t s) const {
