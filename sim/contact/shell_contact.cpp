@@ -13,23 +13,6 @@ constexpr std::size_t kGrain = 2048;
 constexpr Real kCompressionTolerance = Real(1e-4);
 constexpr Real kSeparationTolerance = Real(1e-6);
 
-// Sums f(i) over [0, n) in fixed chunks combined in order (same result for any threads).
-template <class T, class F>
-T chunked_sum(std::size_t n, bool serial, F f) {
-  const std::size_t chunks = (n + kGrain - 1) / kGrain;
-  std::vector<T> part(chunks, T{});
-  parallel_for(
-      n, kGrain,
-      [&](std::size_t b, std::size_t e) {
-        T acc{};
-        for (std::size_t i = b; i < e; ++i) acc += f(i);
-        part[b / kGrain] = acc;
-      },
-      serial);
-  T total{};
-  for (const T& v : part) total += v;
-  return total;
-}
 }  // namespace
 
 ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& rest,
@@ -134,7 +117,7 @@ void ShellContact::reset(const Vec3* ctrl, bool serial) {
 }
 
 double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
-  const double e = chunked_sum<double>(num_sites(), serial, [&](std::size_t p) {
+  const double e = ordered_reduce(num_sites(), kGrain, serial, 0.0, [&](std::size_t p) {
     Vec3 a1, a2;
     tangents(ctrl, p, a1, a2);
     Mat3 G;
@@ -160,7 +143,7 @@ double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
 }
 
 double ShellContact::energy(const Vec3* ctrl, bool serial) const {
-  return chunked_sum<double>(num_sites(), serial, [&](std::size_t p) {
+  return ordered_reduce(num_sites(), kGrain, serial, 0.0, [&](std::size_t p) {
     Vec3 a1, a2;
     tangents(ctrl, p, a1, a2);
     return static_cast<double>(volume[p] * contact_gradient<Real>(a1, a2, a3e[p], params_, nullptr));
@@ -179,7 +162,7 @@ ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
       return *this;
     }
   };
-  const Acc a = chunked_sum<Acc>(num_sites(), serial, [&](std::size_t p) {
+  const Acc a = ordered_reduce(num_sites(), kGrain, serial, Acc{}, [&](std::size_t p) {
     Vec3 a1, a2;
     tangents(ctrl, p, a1, a2);
     // The frame in double: in float |q3| = 1 - O(1e-7) with a bias, and rebuilding a3E from

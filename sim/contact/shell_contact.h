@@ -8,7 +8,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "sim/contact/contact_model.h"
+#include "sim/contact/contact_energy.h"
+#include "sim/contact/friction_return_map.h"
 #include "sim/core/types.h"
 #include "sim/shell/loop_basis.h"
 

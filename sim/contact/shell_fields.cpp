@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "sim/contact/field_contact.h"
 #include "sim/core/parallel.h"
 #include "sim/mpm/bspline.h"
 
@@ -12,25 +13,6 @@ namespace {
 constexpr Real kBulkMin = Real(1e-3);    ///< bulk share of a node's mass that gets a field
 constexpr Real kShellOnly = Real(1e-4);  ///< below this bulk share the node is shells only
 }  // namespace
-
-// Bardenhagen's contact between two fields a and b at one node: n the unit normal from a
-// towards b, w the inverse masses (0: pinned). When they approach along n they end with
-// the same normal velocity, and their relative tangential velocity drops by c_F times the
-// relative normal one (sticking at zero); equal and opposite momentum changes.
-void ShellFields::contact_pair(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb) {
-  const Real w = wa + wb;
-  if (!(w > 0)) return;
-  const Vec3 u = vb - va;
-  const Real un = u.dot(n);
-  if (un >= 0) return;  // separating
-  Vec3 ut = u - un * n;
-  const Real tl = ut.norm();
-  const Real drop = -friction * un;
-  ut = tl <= drop ? Vec3::Zero() : Vec3(ut * (1 - drop / tl));
-  const Vec3 du = ut - u;
-  va -= (wa / w) * du;
-  vb += (wb / w) * du;
-}
 
 void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bulk) {
   fields_.clear();
@@ -289,7 +271,7 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
                 } else {
                   continue;
                 }
-                contact_pair(nab, std::sqrt(friction_[a] * friction_[b]), winv[a], vel[a], winv[b],
+                field_contact(nab, std::sqrt(friction_[a] * friction_[b]), winv[a], vel[a], winv[b],
                              vel[b]);
               }
             if (bulk) {
@@ -317,7 +299,7 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
                   if (std::abs(d) > Real(0.05)) nb = d > 0 ? own[a] : Vec3(-own[a]);
                 }
                 if (nb.squaredNorm() > 0)
-                  contact_pair(nb, friction_[a], winv[a], vel[a], Real(1) / mk, vk);
+                  field_contact(nb, friction_[a], winv[a], vel[a], Real(1) / mk, vk);
               }
             }
             for (int a : ids) fields_[a].r[fb[a]][n] = vel[a] - v0;

@@ -90,7 +90,6 @@ class ShellFields {
   /// Bulk mass centroids on the grid blocks where shells have fields.
   void bulk_moments(const SparseGrid& combined, const ParticleSet& bulk, std::uint32_t first_bulk,
                     bool serial);
-  static void contact_pair(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb);
   bool active_ = false;
   std::vector<Field> fields_;
   std::vector<Real> friction_;  ///< per shell: c_F against bulk material

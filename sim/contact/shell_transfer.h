@@ -14,7 +14,7 @@
 // (M^-1 (d_i - dbar) . a3E) dpsi/da3E does not grow as m_i -> 0 (a plain kernel gradient
 // would, when a node is reached by a light neighbour's tail only). The force is minus the
 // gradient of the contact energy for the motion a3E <- (I + sum u_i (x) g_i) a3E, so the
-// pair stays energy-consistent (tests/sim/test_contact_grid.cpp checks it).
+// pair stays energy-consistent (tests/sim/contact/test_contact_grid.cpp checks it).
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 namespace shellmpm {
 
@@ -43,13 +44,39 @@ void parallel_for_each(std::size_t n, std::size_t grain, Body&& body, bool seria
       serial);
 }
 
+/// Combines chunk(b, e), the partial result of each chunk [b, e) of `grain` items, in
+/// chunk order starting from `zero`: the same result for any thread count.
+/// T needs operator+=.
+template <class T, class Chunk>
+T ordered_reduce_chunks(std::size_t n, std::size_t grain, bool serial, const T& zero,
+                        Chunk&& chunk) {
+  grain = std::max<std::size_t>(grain, 1);
+  std::vector<T> part((n + grain - 1) / grain, zero);
+  parallel_for(
+      n, grain, [&](std::size_t b, std::size_t e) { part[b / grain] = chunk(b, e); }, serial);
+  T total = zero;
+  for (const T& v : part) total += v;
+  return total;
+}
+
+/// Sums f(i) over [0, n): each chunk of `grain` items from `zero` in index order, then
+/// the chunk sums in chunk order (ordered_reduce_chunks).
+template <class T, class F>
+T ordered_reduce(std::size_t n, std::size_t grain, bool serial, const T& zero, F&& f) {
+  return ordered_reduce_chunks(n, grain, serial, zero, [&](std::size_t b, std::size_t e) {
+    T acc = zero;
+    for (std::size_t i = b; i < e; ++i) acc += f(i);
+    return acc;
+  });
+}
+
 /// Limits TBB to `threads` workers for the lifetime of this object (0 = all cores).
 class ThreadLimit {
  public:
   explicit ThreadLimit(int threads) {
     if (threads > 0)
-      control_ = std::make_unique<tbb::global_control>(
-          tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+      control_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                       static_cast<std::size_t>(threads));
   }
   /// The number of threads TBB may use now.
   static int active() {

@@ -21,7 +21,7 @@
 //      pi/4 step when the pivot is nearly degenerate): per rotation it is ~25% faster
 //      here but needs 6 sweeps instead of 4 for machine precision on clustered singular
 //      values, so the exact angle wins. Four sweeps reach machine precision in float and
-//      double on every case in tests/sim/test_svd3.cpp (repeated, clustered, zero and
+//      double on every case in tests/sim/math/test_svd3.cpp (repeated, clustered, zero and
 //      negative singular values; in float three sweeps fail there) and on 3 million
 //      adversarial double-precision cases tried during development (worst reconstruction
 //      error 19 eps); there is no data-dependent loop or branch, only selects.

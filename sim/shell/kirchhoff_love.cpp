@@ -172,19 +172,6 @@ inline void mul2(const T* A, const T* B, T* out) {  // row-major 2x2 product
   out[3] = A[2] * B[1] + A[3] * B[3];
 }
 
-/// Sums per-chunk partial values in chunk order (deterministic for any thread count).
-template <class Fn>
-double chunked_sum(std::size_t n, std::size_t grain, bool serial, Fn&& fn) {
-  if (n == 0) return 0.0;
-  const std::size_t chunks = (n + grain - 1) / grain;
-  std::vector<double> part(chunks, 0.0);
-  parallel_for(
-      n, grain, [&](std::size_t b, std::size_t e) { part[b / grain] = fn(b, e); }, serial);
-  double s = 0.0;
-  for (double p : part) s += p;
-  return s;
-}
-
 }  // namespace
 
 template <class T>
@@ -460,7 +447,7 @@ template <class T>
 T KirchhoffLoveShellT<T>::project_plasticity(const Vec3T* x, bool serial) {
   if (!has_plasticity()) return T(0);
   const double work =
-      chunked_sum(area_.size(), kPointGrain, serial, [&](std::size_t b, std::size_t e) {
+      ordered_reduce_chunks(area_.size(), kPointGrain, serial, 0.0, [&](std::size_t b, std::size_t e) {
         double w = 0.0;
         for (std::size_t q = b; q < e; ++q) {
           PointKinematics<T> k;

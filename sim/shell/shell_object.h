@@ -37,7 +37,7 @@ class ShellObject {
   /// and the solve are in double (a temporary double copy of the Kirchhoff-Love data):
   /// float positions round by ulp(|x|) (1.5e-8 m at 0.2 m from the origin), a membrane
   /// force noise of up to E t ulp(|x|) per control point. Measured on the cantilever of
-  /// tests/sim/test_cantilever.cpp (E = 1e7 Pa, t = 2 mm): 1e-4 N at the float-rounded
+  /// tests/sim/shell/test_cantilever.cpp (E = 1e7 Pa, t = 2 mm): 1e-4 N at the float-rounded
   /// rest state, with the double kernel as with the float one, 2 to 8 times its nodal tip
   /// loads; so the state itself, not the kernel's arithmetic, must be double.
   /// Newton-like L-BFGS with a finite-difference stiffness (static_solver.h); stops at

@@ -3,7 +3,7 @@
 // material's wave speed, the fastest particles, shells and colliders, shot.dt_max), with
 // the step it imposes and a sentence naming the object and the value. `check` prints the
 // list and warns when the step would fall below shot.dt_min; the run's dt_min error names
-// the first entry. The numbers are those of the solver (tests/sim/test_step_limits.cpp
+// the first entry. The numbers are those of the solver (tests/sim/solver/test_step_limits.cpp
 // asserts that the smallest equals Solver::stable_dt()).
 #pragma once
 #include <string>

@@ -1,10 +1,11 @@
-// Contact elasticity and friction of one contact particle (sim/contact/contact_model.h):
+// Contact elasticity and friction of one contact particle (sim/contact/contact_energy.h, friction_return_map.h):
 // finite differences of the energy against its gradient and Kirchhoff stress, and the
 // Coulomb return mapping.
 #include <catch2/catch.hpp>
 #include <random>
 
-#include "sim/contact/contact_model.h"
+#include "sim/contact/contact_energy.h"
+#include "sim/contact/friction_return_map.h"
 
 using namespace shellmpm;
 using V3 = Eigen::Vector3d;

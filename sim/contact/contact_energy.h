@@ -1,5 +1,6 @@
-// Contact elasticity and Coulomb friction of one contact particle (Guo et al. 2018,
-// supplement sections 4-6; Jiang, Gast, Teran 2017 for the QR formulation).
+// Contact elasticity of one contact particle (Guo et al. 2018, supplement sections 4-5,
+// eqs. 9-23; Jiang, Gast, Teran 2017 for the QR formulation). The friction return
+// mapping (section 6) is in friction_return_map.h.
 //
 // A contact particle sits at a fixed parametric site of a shell. Its elastic
 // deformation has the columns D = [a_1, a_2, a3E]: the surface tangents (from the control
@@ -26,9 +27,9 @@ struct ContactParams {
 template <class T>
 struct ContactFrameT {
   using V3 = Eigen::Matrix<T, 3, 1>;
-  V3 q[3];       ///< orthonormal frame: q1 along a_1, q3 the unit normal
+  V3 q[3];          ///< orthonormal frame: q1 along a_1, q3 the unit normal
   T r11, r12, r22;  ///< in-plane block of R
-  V3 s;          ///< third column of R: Q^T a3E
+  V3 s;             ///< third column of R: Q^T a3E
 };
 
 /// Gram-Schmidt QR of [a1, a2, a3E] (a1, a2 must be independent).
@@ -97,7 +98,8 @@ T contact_gradient(const Eigen::Matrix<T, 3, 1>& a1, const Eigen::Matrix<T, 3, 1
 template <class T>
 Eigen::Matrix<T, 3, 3> contact_kirchhoff(const Eigen::Matrix<T, 3, 1>& a1,
                                          const Eigen::Matrix<T, 3, 1>& a2,
-                                         const Eigen::Matrix<T, 3, 1>& a3e, const ContactParams& p) {
+                                         const Eigen::Matrix<T, 3, 1>& a3e,
+                                         const ContactParams& p) {
   const ContactFrameT<T> f = contact_frame(a1, a2, a3e);
   const Eigen::Matrix<T, 3, 1> d = contact_dpsi_ds(f.s, p);
   const T g = static_cast<T>(p.gamma);
@@ -109,29 +111,6 @@ Eigen::Matrix<T, 3, 3> contact_kirchhoff(const Eigen::Matrix<T, 3, 1>& a1,
   Eigen::Matrix<T, 3, 3> Q;
   for (int i = 0; i < 3; ++i) Q.col(i) = f.q[i];
   return Q * B * Q.transpose();
-}
-
-/// What the return mapping did to one particle.
-enum class ContactState : unsigned char { Separated = 0, Sticking = 1, Sliding = 2 };
-
-/// Coulomb return mapping on s (supplement sec. 6): separated (s3 > 1) -> (0, 0, 1);
-/// compressed with gamma |(s1, s2)| > c_F k_c (1 - s3)^2 -> shear scaled onto that bound.
-template <class T>
-ContactState contact_return_map(Eigen::Matrix<T, 3, 1>& s, const ContactParams& p) {
-  if (s[2] >= 1) {
-    s = Eigen::Matrix<T, 3, 1>(0, 0, 1);
-    return ContactState::Separated;
-  }
-  const T c = 1 - s[2];
-  const T bound = static_cast<T>(p.friction * p.kc / p.gamma) * c * c;
-  const T n = std::sqrt(s[0] * s[0] + s[1] * s[1]);
-  if (n > bound) {
-    const T k = n > 0 ? bound / n : T(0);
-    s[0] *= k;
-    s[1] *= k;
-    return ContactState::Sliding;
-  }
-  return ContactState::Sticking;
 }
 
 }  // namespace shellmpm

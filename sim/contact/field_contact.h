@@ -1,0 +1,28 @@
+// Bardenhagen's contact rule between two velocity fields at one grid node (Bardenhagen
+// et al. 2000, "Contact algorithm for granular materials"; used by shell_fields.cpp).
+#pragma once
+#include "sim/core/types.h"
+
+namespace shellmpm {
+
+/// Fields a and b at one node: n the unit normal from a towards b, wa and wb their
+/// inverse masses (0: pinned, infinitely heavy), va and vb their velocities. When they
+/// approach along n they end with the same normal velocity, and their relative
+/// tangential velocity drops by `friction` times the relative normal one (sticking at
+/// zero); the momentum changes are equal and opposite. Separating fields keep theirs.
+inline void field_contact(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb) {
+  const Real w = wa + wb;
+  if (!(w > 0)) return;
+  const Vec3 u = vb - va;
+  const Real un = u.dot(n);
+  if (un >= 0) return;  // separating
+  Vec3 ut = u - un * n;
+  const Real tl = ut.norm();
+  const Real drop = -friction * un;
+  ut = tl <= drop ? Vec3::Zero() : Vec3(ut * (1 - drop / tl));
+  const Vec3 du = ut - u;
+  va -= (wa / w) * du;
+  vb += (wb / w) * du;
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,16 @@
+// Stage "collider_particles": Particle-level collider projection after advection
+// (particle_projection.h): bulk particles and free control points inside a collider go to its
+// surface.
+#pragma once
+#include "sim/solver/stages/stage.h"
+
+namespace shellmpm {
+
+class ColliderParticlesStage final : public Stage {
+ public:
+  static bool needed(const Scene& s);
+  std::string_view name() const override { return "collider_particles"; }
+  void run(StepContext& c) override;
+};
+
+}  // namespace shellmpm

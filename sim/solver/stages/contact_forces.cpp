@@ -1,0 +1,24 @@
+#include "sim/solver/stages/contact_forces.h"
+
+#include "sim/solver/stages/scene_rules.h"
+
+namespace shellmpm {
+
+bool ContactForcesStage::needed(const Scene& s) {
+  return any_contact_shell(s);
+}
+
+void ContactForcesStage::run(StepContext& c) {
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < c.shells.size(); ++i) {
+    if (!c.contacts[i]) continue;
+    GridShell& g = c.grid_shells[k++];
+    prescribe_pins(*g.shell, c.time, c.dt, g.held);
+    g.contact->update_positions(g.shell->x.data(), c.opt.serial);
+    g.force.swap(c.shell_forces[i]);
+    g.contact->forces(g.shell->x.data(), g.force.data(), c.opt.serial);
+  }
+  c.clamp_to_domain();
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,17 @@
+#include "sim/solver/stages/contact_grid.h"
+
+#include "sim/solver/stages/scene_rules.h"
+
+namespace shellmpm {
+
+bool ContactGridStage::needed(const Scene& s) {
+  return any_contact_shell(s);
+}
+
+void ContactGridStage::run(StepContext& c) {
+  contact_normal_forces(c.grid, c.shell_table, c.grid_shells, static_cast<Real>(c.dt),
+                        c.opt.serial);
+  c.apply_walls();
+}
+
+}  // namespace shellmpm

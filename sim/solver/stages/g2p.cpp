@@ -1,0 +1,27 @@
+#include "sim/solver/stages/g2p.h"
+
+#include "sim/solver/stages/scene_rules.h"
+
+namespace shellmpm {
+
+bool G2pStage::needed(const Scene& s) {
+  return grid_needed(s);
+}
+
+void G2pStage::run(StepContext& c) {
+  TransferParams tp = c.transfer_params();
+  const Real dt = tp.dt;
+  if (!c.grid_shells.empty())
+    tp.others = [&c, dt](std::size_t b, GridNode* buf) {
+      shell_g2p_block(c.grid, c.shell_table, c.grid_shells, dt, b, buf);
+    };
+  const bool fields = c.shell_fields.active();
+  if (fields)
+    c.shell_fields.before_g2p(
+        c.grid, [&c](const Vec3i& n) { return c.single_velocity_node(n); }, c.opt.serial);
+  grid_to_particles(c.particles, c.grid, tp);
+  if (fields) c.shell_fields.after_g2p(c.grid_shells, dt, c.opt.serial);
+  c.clamp_to_domain();
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,47 @@
+#include "sim/solver/stages/scene_rules.h"
+
+#include "sim/mpm/constitutive.h"
+
+namespace shellmpm {
+
+bool shell_has_contact(const Scene& s, std::size_t i) {
+  const bool others = !s.colliders.empty() || !s.sources.empty() || s.shells.size() > 1;
+  const ShellDesc::Contact mode = s.shells[i].contact;
+  return mode == ShellDesc::Contact::On || (mode == ShellDesc::Contact::Auto && others);
+}
+
+bool any_contact_shell(const Scene& s) {
+  for (std::size_t i = 0; i < s.shells.size(); ++i)
+    if (shell_has_contact(s, i)) return true;
+  return false;
+}
+
+bool any_direct_shell(const Scene& s) {
+  for (std::size_t i = 0; i < s.shells.size(); ++i)
+    if (!shell_has_contact(s, i)) return true;
+  return false;
+}
+
+bool grid_needed(const Scene& s) {
+  return any_contact_shell(s) || !s.sources.empty();
+}
+
+bool any_plastic_material(const Scene& s) {
+  for (const MaterialDesc& m : s.materials)
+    if (ConstitutiveModel::from_desc(m).has_plasticity()) return true;
+  return false;
+}
+
+bool any_denting_shell(const Scene& s) {
+  for (const ShellDesc& sd : s.shells)
+    if (s.shell_materials[sd.material].yield_stress > 0) return true;
+  return false;
+}
+
+bool any_emitting_source(const Scene& s) {
+  for (const SourceDesc& src : s.sources)
+    if (src.emit) return true;
+  return false;
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,28 @@
+#include "sim/solver/stages/shell_forces.h"
+
+#include "sim/solver/stages/scene_rules.h"
+
+namespace shellmpm {
+
+bool ShellForcesStage::needed(const Scene& s) {
+  return !s.shells.empty();
+}
+
+void ShellForcesStage::run(StepContext& c) {
+  const Vec3d zero = Vec3d::Zero();
+  for (std::size_t i = 0; i < c.shells.size(); ++i) {
+    ShellObject& sh = *c.shells[i];
+    if (!c.contacts[i]) {
+      sh.forces(c.scene.shot.gravity, c.shell_forces[i], c.opt.serial);
+      continue;
+    }
+    // On the grid, gravity is applied to the nodes.
+    sh.forces(zero, c.shell_forces[i], c.opt.serial);
+    const Real damp = static_cast<Real>(sh.material().damping);
+    if (damp > 0)
+      for (std::size_t j = 0; j < sh.size(); ++j)
+        c.shell_forces[i][j] -= damp * sh.mass[j] * sh.v[j];
+  }
+}
+
+}  // namespace shellmpm

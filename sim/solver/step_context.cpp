@@ -1,0 +1,75 @@
+#include "sim/solver/step_context.h"
+
+#include "sim/core/parallel.h"
+
+namespace shellmpm {
+
+TransferParams StepContext::transfer_params() const {
+  TransferParams tp;
+  tp.dt = static_cast<Real>(dt);
+  tp.mls = scene.shot.transfer == "mls";
+  tp.serial = opt.serial;
+  tp.models = &models;
+  tp.densities = &densities;
+  tp.first_bulk = static_cast<std::uint32_t>(shell_table.size());
+  return tp;
+}
+
+void StepContext::clamp_to_domain() {
+  const ShotSettings& s = scene.shot;
+  Vec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = static_cast<Real>(s.domain_min[a] + s.dx);
+    hi[a] = static_cast<Real>(s.domain_min[a] + (domain_cells[a] - 1) * s.dx);
+  }
+  parallel_for(
+      particles.size(), kParticleGrain,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t p = b; p < e; ++p)
+          particles.x[p] = particles.x[p].cwiseMax(lo).cwiseMin(hi);
+      },
+      opt.serial);
+  for (GridShell& g : grid_shells) {
+    for (Vec3& x : g.shell->x) x = x.cwiseMax(lo).cwiseMin(hi);
+    for (Vec3& x : g.contact->x) x = x.cwiseMax(lo).cwiseMin(hi);
+  }
+}
+
+void StepContext::apply_walls() {
+  parallel_for(
+      grid.num_grid_blocks(), 16,
+      [&](std::size_t bb, std::size_t be) {
+        for (std::size_t b = bb; b < be; ++b)
+          grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
+            for (int a = 0; a < 3; ++a) {
+              if (n[a] < kWallCells && nd.v[a] < 0) nd.v[a] = 0;
+              if (n[a] > domain_cells[a] - kWallCells && nd.v[a] > 0) nd.v[a] = 0;
+            }
+          });
+      },
+      opt.serial);
+}
+
+bool StepContext::single_velocity_node(const Vec3i& n) const {
+  for (int a = 0; a < 3; ++a)
+    if (n[a] < kWallCells || n[a] > domain_cells[a] - kWallCells) return true;
+  Aabb at;
+  at.lo = at.hi = grid.node_position(n);
+  for (const Collider& c : colliders) {
+    if (!c.bounds().overlaps(at)) continue;
+    Vec3 v = Vec3::Zero();
+    if (c.apply(at.lo, v)) return true;
+  }
+  return false;
+}
+
+void StepContext::add_particles_from(std::size_t i, const std::vector<Vec3d>& pts) {
+  const SourceDesc& src = scene.sources[i];
+  const auto mat = static_cast<std::uint16_t>(src.material);
+  const Real vol = static_cast<Real>(samplers[i].particle_volume());
+  const Vec3 vel = src.velocity.cast<Real>();
+  const Real pl0 = models[mat].initial_plastic();
+  for (const Vec3d& p : pts) particles.push_back(p.cast<Real>(), vel, vol, mat, pl0);
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,90 @@
+// What the stages of a step share (sim/solver/stages/). The solver owns one StepContext,
+// fills it at setup and hands it to every stage in order; each field says which stages
+// write it and which read it, so a new stage can see what it may use and what it must
+// leave as it found it.
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "sim/collider/collider.h"
+#include "sim/contact/shell_contact.h"
+#include "sim/contact/shell_fields.h"
+#include "sim/contact/shell_transfer.h"
+#include "sim/mpm/constitutive.h"
+#include "sim/mpm/particles.h"
+#include "sim/mpm/sparse_grid.h"
+#include "sim/mpm/transfer.h"
+#include "sim/scene/scene.h"
+#include "sim/shell/shell_object.h"
+#include "sim/solver/source_sampler.h"
+
+namespace shellmpm {
+
+struct SolverOptions {
+  bool serial = false;       ///< no threads (tests compare against parallel runs)
+  bool fill_sources = true;  ///< sample fill sources at construction (off when resuming)
+};
+
+struct StepContext {
+  // Fixed at setup; every stage reads them.
+  Scene scene;
+  SolverOptions opt;
+  std::vector<ConstitutiveModel> models;  ///< per bulk material
+  std::vector<Real> densities;            ///< per bulk material [kg/m^3]
+  Vec3i domain_cells{0, 0, 0};            ///< cells of the domain along each axis
+  double shell_dt = 1e300;                ///< stable step of the shells' stiffness [s]
+
+  // Time. The solver writes them before each step; stages read them.
+  double time = 0;  ///< at the start of the step [s]
+  double dt = 0;    ///< of this step [s]
+
+  // Sources and colliders. emit writes the samplers' emission state; colliders poses
+  // each collider for the step (read by collider_particles and the walls check).
+  std::vector<SourceSampler> samplers;
+  std::vector<Collider> colliders;
+
+  // Bulk particles. p2g reads; g2p writes x, v, C, F; plasticity writes F and plastic;
+  // emit appends.
+  ParticleSet particles;
+  // The combined grid. bin writes the binning; p2g writes mass and momentum; grid turns
+  // momentum into velocity; contact_grid, colliders and g2p (shared nodes) change
+  // velocities; g2p reads.
+  SparseGrid grid;
+
+  // Shells, in scene order. shell_forces writes shell_forces; shell_update integrates
+  // the shells without contact; contact moves each contact shell's forces into its
+  // GridShell (a swap) and adds the contact forces; g2p moves the contact shells'
+  // control points; denting writes the shells' plastic state.
+  std::vector<std::unique_ptr<ShellObject>> shells;
+  std::vector<std::vector<Vec3>> shell_forces;          ///< per shell [N]
+  std::vector<std::unique_ptr<ShellContact>> contacts;  ///< per shell; null: no contact
+  std::vector<GridShell>
+      grid_shells;                 ///< the shells with contact, their control points on the grid
+  ShellFields shell_fields;        ///< per-shell velocities on shared nodes: p2g, g2p
+  ShellPointTable shell_table;     ///< grid shells' points in the combined binning
+  std::vector<Vec3> shell_points;  ///< written by bin, read by p2g and g2p
+
+  // Accumulated results (checkpointed): friction writes contact_step and friction_work,
+  // denting writes plastic_work.
+  ContactStepStats contact_step;  ///< the last step's return mapping
+  double friction_work = 0;       ///< [J]
+  double plastic_work = 0;        ///< [J]
+
+  /// Transfer settings for this step (dt, APIC or MLS, materials, where bulk starts).
+  TransferParams transfer_params() const;
+  /// Keeps particles, control points and contact particles one cell inside the domain.
+  void clamp_to_domain();
+  /// Stops the velocity components that point into the domain walls.
+  void apply_walls();
+  /// Nodes where shells keep one shared velocity: walls and colliders.
+  bool single_velocity_node(const Vec3i& n) const;
+  /// Appends bulk particles of source i at positions pts (at rest velocity of the source).
+  void add_particles_from(std::size_t source, const std::vector<Vec3d>& pts);
+};
+
+/// Nodes this close to the domain boundary act as walls.
+constexpr int kWallCells = 3;
+/// Particles per parallel chunk in the particle loops.
+constexpr std::size_t kParticleGrain = 4096;
+
+}  // namespace shellmpm
