@@ -84,7 +84,7 @@ int check_command(const CommonArgs& a) {
   const double steps = std::ceil(1.0 / s.fps / dt);
   double harden = 1;
   for (const ConstitutiveModel& m : solver.models())
-    harden = std::max(harden, static_cast<double>(std::sqrt(m.hardening(m.jp_min))));
+    harden = std::max(harden, static_cast<double>(std::sqrt(m.max_hardening())));
   if (harden > 1.01)
     std::printf("note: compressed snow hardens; its step can get up to %.1fx smaller than this\n",
                 harden);

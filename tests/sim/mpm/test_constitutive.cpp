@@ -144,20 +144,34 @@ Vec3d hencky(const Mat3d& F) {
 
 }  // namespace
 
+namespace {
+// The parameters of a model built by from_desc.
+const shellmpm::DruckerPragerT<double>& dp_of(const Model& m) {
+  return std::get<shellmpm::DruckerPragerT<double>>(m.model);
+}
+const shellmpm::SnowT<double>& snow_of(const Model& m) {
+  return std::get<shellmpm::SnowT<double>>(m.model);
+}
+}  // namespace
+
 TEST_CASE("constitutive: from_desc parameters", "[constitutive]") {
   const Model fcr = Model::from_desc(desc_fcr());
   CHECK(fcr.mu == Approx(1e5 / 2.6));
   CHECK(fcr.lambda == Approx(1e5 * 0.3 / (1.3 * 0.4)));
   CHECK_FALSE(fcr.has_plasticity());
   CHECK(fcr.initial_plastic() == 0.0);
-  const Model sand = Model::from_desc(desc_sand(0.02));
+  const Model sand_m = Model::from_desc(desc_sand(0.02));
+  REQUIRE(std::holds_alternative<shellmpm::DruckerPragerT<double>>(sand_m.model));
+  const auto& sand = std::get<shellmpm::DruckerPragerT<double>>(sand_m.model);
   CHECK(sand.alpha == Approx(std::sqrt(2.0 / 3.0) * 2 * 0.5 / 2.5));  // sin 30 deg = 1/2
   CHECK(sand.cohesion == Approx(0.02));
-  CHECK(sand.has_plasticity());
-  CHECK(sand.initial_plastic() == 0.0);
-  const Model snow = Model::from_desc(desc_snow());
-  CHECK(snow.has_plasticity());
-  CHECK(snow.initial_plastic() == 1.0);
+  CHECK(sand_m.has_plasticity());
+  CHECK(sand_m.initial_plastic() == 0.0);
+  const Model snow_m = Model::from_desc(desc_snow());
+  CHECK(snow_m.has_plasticity());
+  CHECK(snow_m.initial_plastic() == 1.0);
+  REQUIRE(std::holds_alternative<shellmpm::SnowT<double>>(snow_m.model));
+  const auto& snow = std::get<shellmpm::SnowT<double>>(snow_m.model);
   CHECK(snow.theta_c == Approx(2.5e-2));
   CHECK(snow.theta_s == Approx(7.5e-3));
   CHECK(snow.xi == Approx(10.0));
@@ -262,7 +276,7 @@ TEST_CASE("constitutive: Drucker-Prager return mapping", "[constitutive]") {
     auto yield = [&](const Vec3d& eps) {  // <= 0 inside the (shifted) cone
       const Vec3d e = (eps.array() - c).matrix();
       const double tr = e.sum();
-      return (e.array() - tr / 3).matrix().norm() + k * tr * sand.alpha;
+      return (e.array() - tr / 3).matrix().norm() + k * tr * dp_of(sand).alpha;
     };
     DYNAMIC_SECTION("cohesion " << c
                                 << ": projection lands on or inside the cone; inside "
@@ -316,7 +330,7 @@ TEST_CASE("constitutive: Drucker-Prager return mapping", "[constitutive]") {
 
 TEST_CASE("constitutive: snow return mapping and hardening", "[constitutive]") {
   const Model snow = Model::from_desc(desc_snow());
-  const double lo = 1 - snow.theta_c, hi = 1 + snow.theta_s;
+  const double lo = 1 - snow_of(snow).theta_c, hi = 1 + snow_of(snow).theta_s;
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   SECTION("clamped singular values, J_P J_E preserved, inside untouched") {
@@ -352,22 +366,22 @@ TEST_CASE("constitutive: snow return mapping and hardening", "[constitutive]") {
     Mat3d F = 0.5 * Mat3d::Identity();  // strong compression: J_P drops
     double jp = 0.61;
     snow.project(F, jp);
-    CHECK(jp == snow.jp_min);
+    CHECK(jp == snow_of(snow).jp_min);
     F = 1.5 * Mat3d::Identity();  // strong stretch: J_P grows
     jp = 19.0;
     snow.project(F, jp);
-    CHECK(jp == snow.jp_max);
+    CHECK(jp == snow_of(snow).jp_max);
     F = Mat3d::Identity();
     F(0, 0) = -1.0;
     jp = 1.0;
     snow.project(F, jp);
-    CHECK(jp == snow.jp_min);
+    CHECK(jp == snow_of(snow).jp_min);
     CHECK(F.determinant() > 0);
   }
   SECTION("hardening scales energy, stress and wave speed") {
     const Mat3d F = random_rotation(rng) * Vec3d(1.01, 0.98, 0.99).asDiagonal();
     for (double jp : {0.7, 1.0, 1.3}) {
-      const double h = std::exp(snow.xi * (1 - jp));
+      const double h = std::exp(snow_of(snow).xi * (1 - jp));
       CHECK(snow.hardening(jp) == Approx(h));
       CHECK(snow.energy(F, jp) == Approx(h * snow.energy(F, 1.0)).epsilon(1e-12));
       CHECK((snow.kirchhoff(F, jp) - h * snow.kirchhoff(F, 1.0)).norm() <
