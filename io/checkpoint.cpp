@@ -12,6 +12,7 @@
 
 #include "io/atomic_file.h"
 #include "io/checksum.h"
+#include "io/shot_runner.h"
 #include "sim/solver/solver.h"
 
 namespace shellmpm {
@@ -21,7 +22,6 @@ constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '3'};
 constexpr char kEndMagic[8] = {'S', 'H', 'M', 'P', 'M', 'E', 'N', 'D'};
 constexpr std::size_t kHeaderBytes = 8 + 4 + 8;   // magic, sizeof(Real), payload size
 constexpr std::size_t kTrailerBytes = 4 + 8;      // CRC-32, end magic
-constexpr int kMaxFrame = 999999999;              // as --frames accepts
 
 // ---- writing: one serializer, run once to count the payload and once to write it ----
 
@@ -139,7 +139,7 @@ std::string read_whole_file(const std::string& path) {
 void parse_payload(Cursor& in, Checkpoint& c) {
   c.scene_fingerprint = in.get<std::uint64_t>("scene fingerprint");
   c.frame = in.get<std::int32_t>("frame");
-  if (c.frame < 1 || c.frame > kMaxFrame) in.fail("frame " + std::to_string(c.frame) + " is out of range");
+  if (c.frame < 1 || c.frame > kMaxFrameNumber) in.fail("frame " + std::to_string(c.frame) + " is out of range");
   c.time = in.get<double>("time");
   if (!std::isfinite(c.time) || c.time < 0) in.fail("time is negative or not finite");
   const auto n = in.get<std::uint64_t>("particle count");
@@ -296,7 +296,7 @@ void restore_checkpoint(Solver& solver, Checkpoint&& c, const std::string& path)
   if (p.keep_plastic != solver.particles().keep_plastic)
     throw refuse(p.keep_plastic ? "it has plastic state the scene's materials do not use"
                                 : "it has no plastic state, the scene's materials need one");
-  const double expected = (c.frame - 1) / scene.shot.fps;  // shot_runner.h: frame_time
+  const double expected = frame_time(c.frame, scene.shot.fps);
   if (!(std::abs(c.time - expected) <= 0.5 / scene.shot.fps))
     throw refuse("its time " + std::to_string(c.time) + " s is not that of frame " +
                  std::to_string(c.frame) + " (" + std::to_string(expected) + " s)");
@@ -348,10 +348,10 @@ std::vector<CheckpointFile> list_checkpoints(const std::string& dir, int max_fra
     const auto nz = digits.find_first_not_of('0');
     const std::string significant = nz == std::string::npos ? "0" : digits.substr(nz);
     const long long f = significant.size() <= 9 ? std::stoll(significant) : -1;
-    if (f < 1 || f > kMaxFrame) {
+    if (f < 1 || f > kMaxFrameNumber) {
       if (warnings)
         warnings->push_back("ignoring '" + e.path().string() + "': " + digits +
-                            " is not a frame number (1 to " + std::to_string(kMaxFrame) + ")");
+                            " is not a frame number (1 to " + std::to_string(kMaxFrameNumber) + ")");
       continue;
     }
     if (f <= max_frame) found.push_back({e.path().string(), static_cast<int>(f)});

@@ -38,6 +38,10 @@ struct RunResult {
   std::string checkpoint;   ///< the checkpoint written when it stopped early
 };
 
+/// The largest frame number --frames and checkpoint names accept (9 digits, so frame
+/// arithmetic stays far from int's limit).
+constexpr int kMaxFrameNumber = 999999999;
+
 /// Time of a frame's state [s].
 inline double frame_time(int frame, double fps) { return (frame - 1) / fps; }
 
