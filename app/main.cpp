@@ -47,7 +47,8 @@ int main(int argc, char** argv) {
   RunArgs run;
   CLI::App* run_cmd = app.add_subcommand("run", "simulate a scene and write its caches");
   add_common(run_cmd, run);
-  run_cmd->add_option("--frames", run.frames, "frame range A-B (or one frame A)")->check(kFrameRange);
+  run_cmd->add_option("--frames", run.frames, "frame range A-B (or one frame A)")
+      ->check(kFrameRange);
   run_cmd->add_option("--output,-o", run.output, "output directory (replaces output.directory)");
   run_cmd->add_flag("--resume", run.resume, "continue from the newest checkpoint in the output directory");
   run_cmd->add_flag("--preview", run.preview,
@@ -62,7 +63,9 @@ int main(int argc, char** argv) {
   CLI::App* render_cmd = app.add_subcommand(
       "render", "render a run's caches to preview.####.png, a contact sheet and an MP4");
   render_cmd->add_option("OUTDIR", render.outdir, "output directory of a `shellmpm run`")->required();
-  render_cmd->add_option("--frames", render.frames, "frame range A-B (or one frame A); default: the run's")
+  render_cmd
+      ->add_option("--frames", render.frames,
+                   "frame range A-B (or one frame A); default: the run's")
       ->check(kFrameRange);
   render_cmd->add_option("--camera", render.camera, "camera name from render.cameras, or auto");
   render_cmd->add_option("--size", render.size, "image size WxH (e.g. 1280x720)");

@@ -54,7 +54,8 @@ int run_command(const RunArgs& a) {
     if (stop_noted || StopSignals::pending() == 0) return;
     stop_noted = true;
     progress.warning(StopSignals::name(StopSignals::pending()) + ": stopping after frame " +
-                     std::to_string(frame) + " (a checkpoint follows); send it again to stop at once");
+                     std::to_string(frame) +
+                     " (a checkpoint follows); send it again to stop at once");
   };
   RunOptions ro;
   ro.resume = a.resume;

@@ -37,7 +37,9 @@ StopSignals::~StopSignals() {
   sigaction(SIGINT, &g_old_int, nullptr);
 }
 
-int StopSignals::pending() { return g_pending; }
+int StopSignals::pending() {
+  return g_pending;
+}
 
 std::string StopSignals::name(int signal) {
   if (signal == SIGTERM) return "SIGTERM";

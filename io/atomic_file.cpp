@@ -31,7 +31,8 @@ void fsync_path(const std::string& path, bool directory) {
   const int err = errno;
   ::close(fd);
   // Directories on some file systems reject fsync with EINVAL; the rename still holds.
-  if (rc != 0 && !(directory && (err == EINVAL || err == EBADF))) throw_errno(err, "cannot fsync", path);
+  if (rc != 0 && !(directory && (err == EINVAL || err == EBADF)))
+    throw_errno(err, "cannot fsync", path);
 }
 
 std::string parent_dir(const std::string& path) {
@@ -90,7 +91,9 @@ class CheckedFile::Buffer : public std::streambuf {
   int sync() override { return drain() ? 0 : -1; }
   pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
     if (!drain()) return pos_type(off_type(-1));
-    const int whence = dir == std::ios_base::beg ? SEEK_SET : dir == std::ios_base::cur ? SEEK_CUR : SEEK_END;
+    const int whence = dir == std::ios_base::beg   ? SEEK_SET
+                       : dir == std::ios_base::cur ? SEEK_CUR
+                                                   : SEEK_END;
     const off_t r = ::lseek(fd_, static_cast<off_t>(off), whence);
     if (r < 0) {
       set_error(errno);
@@ -138,7 +141,9 @@ CheckedFile::~CheckedFile() {
   if (buf_ && buf_->fd() >= 0 && stream_) ::close(buf_->fd());
 }
 
-std::ostream& CheckedFile::stream() { return *stream_; }
+std::ostream& CheckedFile::stream() {
+  return *stream_;
+}
 
 void CheckedFile::write(const void* data, std::size_t size) {
   stream_->write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
@@ -156,7 +161,8 @@ void CheckedFile::close() {
   if (buf_->error() != 0) throw_errno(buf_->error(), "cannot write", path_);
 }
 
-void write_stream_atomic(const std::string& path, const std::function<void(CheckedFile& out)>& fill) {
+void write_stream_atomic(const std::string& path,
+                         const std::function<void(CheckedFile& out)>& fill) {
   const std::string tmp = atomic_temp_path(path);
   try {
     CheckedFile out(tmp);

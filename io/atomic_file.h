@@ -45,7 +45,8 @@ class CheckedFile {
 /// flush, fsync, close or the rename fails, the temporary is removed, `path` is left as
 /// it was, and the exception propagates (I/O failures throw std::system_error naming
 /// the file).
-void write_stream_atomic(const std::string& path, const std::function<void(CheckedFile& out)>& fill);
+void write_stream_atomic(const std::string& path,
+                         const std::function<void(CheckedFile& out)>& fill);
 
 /// Writes `path` atomically for writers that open the file themselves (libpng on a
 /// FILE*): `writer(tmp_path)` must create, fill, check and close `tmp_path` (a sibling

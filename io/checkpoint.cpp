@@ -20,8 +20,8 @@ namespace {
 
 constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '3'};
 constexpr char kEndMagic[8] = {'S', 'H', 'M', 'P', 'M', 'E', 'N', 'D'};
-constexpr std::size_t kHeaderBytes = 8 + 4 + 8;   // magic, sizeof(Real), payload size
-constexpr std::size_t kTrailerBytes = 4 + 8;      // CRC-32, end magic
+constexpr std::size_t kHeaderBytes = 8 + 4 + 8;  // magic, sizeof(Real), payload size
+constexpr std::size_t kTrailerBytes = 4 + 8;     // CRC-32, end magic
 
 // ---- writing: one serializer, run once to count the payload and once to write it ----
 
@@ -113,7 +113,9 @@ struct Cursor {
   }
 };
 
-bool finite(Real x) { return std::isfinite(x); }
+bool finite(Real x) {
+  return std::isfinite(x);
+}
 template <class M>
 bool finite(const M& m) {
   return m.allFinite();
@@ -132,14 +134,16 @@ std::string read_whole_file(const std::string& path) {
   if (ec) throw CheckpointDamaged(path, "cannot read its size: " + ec.message());
   std::string bytes(size, '\0');
   f.read(bytes.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(f.gcount()) != size) throw CheckpointDamaged(path, "cannot read it");
+  if (static_cast<std::uintmax_t>(f.gcount()) != size)
+    throw CheckpointDamaged(path, "cannot read it");
   return bytes;
 }
 
 void parse_payload(Cursor& in, Checkpoint& c) {
   c.scene_fingerprint = in.get<std::uint64_t>("scene fingerprint");
   c.frame = in.get<std::int32_t>("frame");
-  if (c.frame < 1 || c.frame > kMaxFrameNumber) in.fail("frame " + std::to_string(c.frame) + " is out of range");
+  if (c.frame < 1 || c.frame > kMaxFrameNumber)
+    in.fail("frame " + std::to_string(c.frame) + " is out of range");
   c.time = in.get<double>("time");
   if (!std::isfinite(c.time) || c.time < 0) in.fail("time is negative or not finite");
   const auto n = in.get<std::uint64_t>("particle count");
@@ -165,7 +169,8 @@ void parse_payload(Cursor& in, Checkpoint& c) {
     if (!(p.volume[i] > 0) || !std::isfinite(p.volume[i]))
       in.fail("particle volume[" + std::to_string(i) + "] is not positive and finite");
     if (p.id[i] >= p.next_id)
-      in.fail("particle id[" + std::to_string(i) + "] is not below next id " + std::to_string(p.next_id));
+      in.fail("particle id[" + std::to_string(i) + "] is not below next id " +
+              std::to_string(p.next_id));
   }
   const auto len = in.get<std::uint64_t>("statistics length");
   if (len > in.left()) in.fail("statistics claim more bytes than the file holds");
@@ -175,7 +180,8 @@ void parse_payload(Cursor& in, Checkpoint& c) {
   if (!stats.is_array()) in.fail("statistics are not a JSON array");
   const auto nshells = in.get<std::uint64_t>("shell count");
   // Each shell holds five length prefixes at least.
-  if (nshells > in.left() / (5 * sizeof(std::uint64_t))) in.fail("shell count is larger than the file holds");
+  if (nshells > in.left() / (5 * sizeof(std::uint64_t)))
+    in.fail("shell count is larger than the file holds");
   c.shell_plastic_work = in.get<double>("shell plastic work");
   c.friction_work = in.get<double>("friction work");
   if (!std::isfinite(c.shell_plastic_work) || !std::isfinite(c.friction_work))
@@ -233,14 +239,17 @@ Checkpoint read_checkpoint(const std::string& path) {
                     "); resume needs a checkpoint written by this version");
     throw damaged("not a shellmpm checkpoint (bad magic)");
   }
-  if (bytes.size() < kHeaderBytes + kTrailerBytes) throw damaged("truncated: the header is incomplete");
+  if (bytes.size() < kHeaderBytes + kTrailerBytes)
+    throw damaged("truncated: the header is incomplete");
   std::uint32_t real_size;
   std::uint64_t payload;
   std::memcpy(&real_size, bytes.data() + 8, 4);
   std::memcpy(&payload, bytes.data() + 12, 8);
   if (payload != bytes.size() - kHeaderBytes - kTrailerBytes)
     throw damaged("the file has " + std::to_string(bytes.size()) + " bytes, its header says " +
-                  (payload > bytes.size() ? std::string("more") : std::to_string(payload + kHeaderBytes + kTrailerBytes)) +
+                  (payload > bytes.size()
+                       ? std::string("more")
+                       : std::to_string(payload + kHeaderBytes + kTrailerBytes)) +
                   " (truncated, extended or damaged)");
   const char* trailer = bytes.data() + kHeaderBytes + payload;
   if (std::memcmp(trailer + 4, kEndMagic, 8) != 0) throw damaged("missing end marker");
@@ -351,7 +360,8 @@ std::vector<CheckpointFile> list_checkpoints(const std::string& dir, int max_fra
     if (f < 1 || f > kMaxFrameNumber) {
       if (warnings)
         warnings->push_back("ignoring '" + e.path().string() + "': " + digits +
-                            " is not a frame number (1 to " + std::to_string(kMaxFrameNumber) + ")");
+                            " is not a frame number (1 to " + std::to_string(kMaxFrameNumber) +
+                            ")");
       continue;
     }
     if (f <= max_frame) found.push_back({e.path().string(), static_cast<int>(f)});

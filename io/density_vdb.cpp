@@ -81,7 +81,8 @@ std::string describe(const Vec3& x) {
 /// a CheckedFile, whose close() reports any failed write.
 class VdbFileWriter : public openvdb::io::Archive {
  public:
-  void write_file(std::ostream& os, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& meta) const {
+  void write_file(std::ostream& os, const openvdb::GridPtrVec& grids,
+                  const openvdb::MetaMap& meta) const {
     Archive::write(os, grids, /*seekable=*/true, meta);
   }
 };
@@ -297,7 +298,8 @@ void write_density_vdb(const std::string& path, const DensityInput& in, const Vd
   add_metadata(file_meta, o);
   VdbFileWriter archive;
   archive.setCompression(compression_flags());
-  write_stream_atomic(path, [&](CheckedFile& out) { archive.write_file(out.stream(), grids, file_meta); });
+  write_stream_atomic(
+      path, [&](CheckedFile& out) { archive.write_file(out.stream(), grids, file_meta); });
 }
 
 DensityStats read_density_vdb(const std::string& path) {

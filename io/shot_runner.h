@@ -33,9 +33,9 @@ struct RunOptions {
 /// What run_shot did.
 struct RunResult {
   int frames_written = 0;
-  int last_frame = 0;       ///< the last frame simulated (0 if none)
-  int stopped_by = 0;       ///< stop_requested's value when the run stopped early, else 0
-  std::string checkpoint;   ///< the checkpoint written when it stopped early
+  int last_frame = 0;      ///< the last frame simulated (0 if none)
+  int stopped_by = 0;      ///< stop_requested's value when the run stopped early, else 0
+  std::string checkpoint;  ///< the checkpoint written when it stopped early
 };
 
 /// The largest frame number --frames and checkpoint names accept (9 digits, so frame

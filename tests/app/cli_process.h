@@ -60,9 +60,12 @@ inline CmdResult wait_child(const Child& c) {
   int status = 0;
   waitpid(c.pid, &status, 0);
   CmdResult r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? -WTERMSIG(status) : -1000;
+  r.code = WIFEXITED(status)     ? WEXITSTATUS(status)
+           : WIFSIGNALED(status) ? -WTERMSIG(status)
+                                 : -1000;
   r.output = read_text(c.log);
-  if (WIFSIGNALED(status)) r.output += "\n[killed by signal " + std::to_string(WTERMSIG(status)) + "]";
+  if (WIFSIGNALED(status))
+    r.output += "\n[killed by signal " + std::to_string(WTERMSIG(status)) + "]";
   return r;
 }
 

@@ -68,9 +68,10 @@ std::vector<Section> sections(const std::string& b) {
   std::uint32_t real = 0;
   std::memcpy(&real, b.data() + 8, 4);
   REQUIRE((real == 4 || real == 8));
-  std::vector<Section> s = {{"magic", 3},          {"precision", 8},  {"payload size", 13},
-                            {"scene fingerprint", 22}, {"frame", 28}, {"time", 36},
-                            {"particle count", 40}, {"next id", 49}, {"plastic flag", 52}};
+  std::vector<Section> s = {
+      {"magic", 3},        {"precision", 8}, {"payload size", 13},   {"scene fingerprint", 22},
+      {"frame", 28},       {"time", 36},     {"particle count", 40}, {"next id", 49},
+      {"plastic flag", 52}};
   std::size_t at = 53;
   auto array = [&](const std::string& name, std::size_t elem) {
     const std::uint64_t n = u64(at);
@@ -81,9 +82,13 @@ std::vector<Section> sections(const std::string& b) {
     at += 8 + n * elem;
   };
   for (const auto& [name, elem] : std::vector<std::pair<std::string, std::size_t>>{
-           {"particle positions", 3 * real}, {"particle velocities", 3 * real},
-           {"particle APIC matrices", 9 * real}, {"particle deformation gradients", 9 * real},
-           {"particle volumes", real}, {"particle materials", 2}, {"particle ids", 4},
+           {"particle positions", 3 * real},
+           {"particle velocities", 3 * real},
+           {"particle APIC matrices", 9 * real},
+           {"particle deformation gradients", 9 * real},
+           {"particle volumes", real},
+           {"particle materials", 2},
+           {"particle ids", 4},
            {"particle plastic state", real}})
     array(name, elem);
   const std::uint64_t stats = u64(at);
@@ -93,9 +98,12 @@ std::vector<Section> sections(const std::string& b) {
   s.push_back({"shell count", at});
   s.push_back({"accumulated work", at + 8 + 3});
   at += 8 + 16;
-  for (const auto& [name, elem] : std::vector<std::pair<std::string, std::size_t>>{
-           {"shell positions", 3 * real}, {"shell velocities", 3 * real}, {"shell plastic state", real},
-           {"shell APIC matrices", 9 * real}, {"shell contact normals", 3 * real}})
+  for (const auto& [name, elem] :
+       std::vector<std::pair<std::string, std::size_t>>{{"shell positions", 3 * real},
+                                                        {"shell velocities", 3 * real},
+                                                        {"shell plastic state", real},
+                                                        {"shell APIC matrices", 9 * real},
+                                                        {"shell contact normals", 3 * real}})
     array(name, elem);
   s.push_back({"checksum", at + 1});
   s.push_back({"end marker", at + 4 + 6});
@@ -112,13 +120,15 @@ nlohmann::json physics_stats(const std::string& path) {
 
 /// The resumed run's frames 3 and 4 match the uninterrupted run's, byte for byte.
 void expect_same_results(const std::string& full, const std::string& resumed) {
-  for (const char* f : {"cloth.0003.ply", "cloth.0004.ply", "particles.0003.ply", "particles.0004.ply"}) {
+  for (const char* f :
+       {"cloth.0003.ply", "cloth.0004.ply", "particles.0003.ply", "particles.0004.ply"}) {
     INFO(f);
     const std::string a = read_text(full + "/" + f);
     REQUIRE(!a.empty());
     CHECK(a == read_text(resumed + "/" + f));
   }
-  CHECK(physics_stats(full + "/stats.json").dump() == physics_stats(resumed + "/stats.json").dump());
+  CHECK(physics_stats(full + "/stats.json").dump() ==
+        physics_stats(resumed + "/stats.json").dump());
 }
 
 void damage(const std::string& path, std::size_t offset) {
@@ -192,8 +202,9 @@ TEST_CASE("CLI: a damaged newest checkpoint falls back to the previous one; none
   // rerun the two runs.
   const std::vector<Section> secs = sections(read_text(runs.part + "/checkpoint.0003.bin"));
   for (const Section& sec : secs)
-    for (const char* pick : {"magic", "payload size", "frame", "particle positions", "particle materials",
-                             "statistics", "shell contact normals", "checksum"})
+    for (const char* pick :
+         {"magic", "payload size", "frame", "particle positions", "particle materials",
+          "statistics", "shell contact normals", "checksum"})
       if (sec.name == pick) runs.expect_fallback(sec.name, sec.offset);
   runs.expect_fallback("cut in half", std::string::npos);
   {
@@ -206,14 +217,16 @@ TEST_CASE("CLI: a damaged newest checkpoint falls back to the previous one; none
     CHECK(r.code == 2);
     CHECK(r.output.find("no intact checkpoint to resume from (3 damaged)") != std::string::npos);
     for (int f = 1; f <= 3; ++f)
-      CHECK(r.output.find(out + "/checkpoint.000" + std::to_string(f) + ".bin") != std::string::npos);
+      CHECK(r.output.find(out + "/checkpoint.000" + std::to_string(f) + ".bin") !=
+            std::string::npos);
     CHECK_FALSE(fs::exists(out + "/cloth.0004.ply"));
     CHECK(read_text(out + "/stats.json") == stats);
   }
 }
 
-TEST_CASE("CLI: a byte damaged in every section of a real checkpoint falls back to the previous one",
-          "[cli][resume][checkpoint][slow]") {
+TEST_CASE(
+    "CLI: a byte damaged in every section of a real checkpoint falls back to the previous one",
+    "[cli][resume][checkpoint][slow]") {
   Runs runs;
   for (const Section& sec : sections(read_text(runs.part + "/checkpoint.0003.bin")))
     runs.expect_fallback(sec.name, sec.offset);

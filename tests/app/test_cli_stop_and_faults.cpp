@@ -55,10 +55,11 @@ nlohmann::json physics_stats(const std::string& path) {
 /// exit 128 + signal, a checkpoint of the last frame written although
 /// output.checkpoint_every is 0, a message pointing to --resume, no temporaries; then
 /// resumes and compares every frame with the uninterrupted run in `full`.
-void stop_and_resume(const TempDir& d, const std::string& scene, const std::string& full, int signal,
-                     const std::string& name) {
+void stop_and_resume(const TempDir& d, const std::string& scene, const std::string& full,
+                     int signal, const std::string& name) {
   const std::string out = d.file(name);
-  const Child c = spawn_shellmpm({"run", scene, "-q", "--threads", "1", "-o", out}, d.file(name + ".log"));
+  const Child c =
+      spawn_shellmpm({"run", scene, "-q", "--threads", "1", "-o", out}, d.file(name + ".log"));
   REQUIRE(c.pid > 0);
   const bool started = wait_for_file(out + "/particles.0002.ply", 60);
   kill(c.pid, signal);
@@ -67,8 +68,9 @@ void stop_and_resume(const TempDir& d, const std::string& scene, const std::stri
   REQUIRE(started);
   REQUIRE(r.code == 128 + signal);
   std::smatch m;
-  const std::regex re("stopped by (SIG[A-Z]+) after frame ([0-9]+) .*checkpoint '([^']+)' written: "
-                      "run the same command with --resume to continue");
+  const std::regex re(
+      "stopped by (SIG[A-Z]+) after frame ([0-9]+) .*checkpoint '([^']+)' written: "
+      "run the same command with --resume to continue");
   REQUIRE(std::regex_search(r.output, m, re));
   CHECK(m[1] == (signal == SIGTERM ? "SIGTERM" : "SIGINT"));
   const int last = std::stoi(m[2]);
@@ -103,19 +105,22 @@ TEST_CASE("CLI: SIGTERM and SIGINT stop after the frame with a checkpoint; --res
   stop_and_resume(d, s, d.file("full"), SIGINT, "int");
 }
 
-TEST_CASE("CLI: a write that fails (file size limit, like a full disk) exits 1 naming the file; "
-          "nothing already written changes",
-          "[cli][atomic]") {
+TEST_CASE(
+    "CLI: a write that fails (file size limit, like a full disk) exits 1 naming the file; "
+    "nothing already written changes",
+    "[cli][atomic]") {
   TempDir d("disk_full");
   const std::string s = make_scene(d);
   const std::string out = d.file("o");
   REQUIRE(run_shellmpm("run " + s + " -q --frames 1-3 -o " + out).code == 0);
-  const std::string vdb = read_text(out + "/density.0001.vdb"), stats = read_text(out + "/stats.json");
+  const std::string vdb = read_text(out + "/density.0001.vdb"),
+                    stats = read_text(out + "/stats.json");
   constexpr std::size_t kLimit = 16 * 1024;  // above run.json, below one density frame
   REQUIRE(vdb.size() > 2 * kLimit);
   REQUIRE(fs::file_size(out + "/run.json") < kLimit);
 
-  const Child c = spawn_shellmpm({"run", s, "-q", "--frames", "1-3", "-o", out}, d.file("run.log"), kLimit);
+  const Child c =
+      spawn_shellmpm({"run", s, "-q", "--frames", "1-3", "-o", out}, d.file("run.log"), kLimit);
   const CmdResult r = wait_child(c);
   INFO(r.output);
   CHECK(r.code == 1);
@@ -128,8 +133,8 @@ TEST_CASE("CLI: a write that fails (file size limit, like a full disk) exits 1 n
 
   // Into an empty folder: no truncated frame under its final name.
   const std::string fresh = d.file("fresh");
-  const CmdResult r2 = wait_child(
-      spawn_shellmpm({"run", s, "-q", "--frames", "1-3", "-o", fresh}, d.file("fresh.log"), kLimit));
+  const CmdResult r2 = wait_child(spawn_shellmpm({"run", s, "-q", "--frames", "1-3", "-o", fresh},
+                                                 d.file("fresh.log"), kLimit));
   INFO(r2.output);
   CHECK(r2.code == 1);
   CHECK_FALSE(fs::exists(fresh + "/density.0001.vdb"));

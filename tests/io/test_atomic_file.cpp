@@ -89,7 +89,8 @@ std::vector<Writer> all_writers() {
   // still see the failed writes.
   w.push_back({"careless stream", "s.txt", [](const std::string& path, bool large) {
                  write_stream_atomic(path, [&](CheckedFile& out) {
-                   for (int i = 0; i < (large ? 100000 : 2); ++i) out.stream() << "line " << i << "\n";
+                   for (int i = 0; i < (large ? 100000 : 2); ++i)
+                     out.stream() << "line " << i << "\n";
                  });
                }});
   w.push_back({"density VDB", "density.0006.vdb", [](const std::string& path, bool large) {
@@ -97,7 +98,8 @@ std::vector<Writer> all_writers() {
                  VdbOptions o;
                  o.voxel_size = 0.01;
                  o.velocity = true;
-                 write_density_vdb(path, DensityInput{p.x.data(), p.v.data(), p.volume.data(), p.size()}, o);
+                 write_density_vdb(
+                     path, DensityInput{p.x.data(), p.v.data(), p.volume.data(), p.size()}, o);
                }});
   for (MeshFormat f : {MeshFormat::Ply, MeshFormat::Obj, MeshFormat::Glb})
     w.push_back({std::string("shell mesh ") + mesh_format_extension(f),
@@ -155,8 +157,10 @@ TEST_CASE("CheckedFile writes through write() and a seekable stream", "[atomic]"
   CHECK_THROWS_AS(CheckedFile(dir.file("missing/a.bin")), std::system_error);
 }
 
-TEST_CASE("every writer, past the file size limit: an error naming the file, the old file intact, no temporary",
-          "[atomic]") {
+TEST_CASE(
+    "every writer, past the file size limit: an error naming the file, the old file intact, no "
+    "temporary",
+    "[atomic]") {
   for (const Writer& w : all_writers()) {
     DYNAMIC_SECTION(w.name) {
       TempDir dir("atomic_limit");
@@ -197,7 +201,8 @@ TEST_CASE("a density VDB that fails half-way leaves the previous frame readable"
   const ParticleSet small = cloud(50, 0.05), large = cloud(40000);
   VdbOptions o;
   o.voxel_size = 0.01;
-  write_density_vdb(path, DensityInput{small.x.data(), nullptr, small.volume.data(), small.size()}, o);
+  write_density_vdb(path, DensityInput{small.x.data(), nullptr, small.volume.data(), small.size()},
+                    o);
   const DensityStats before = read_density_vdb(path);
   constexpr std::size_t kLimit = 512 * 1024;
   write_density_vdb(dir.file("unlimited.vdb"),
@@ -208,7 +213,8 @@ TEST_CASE("a density VDB that fails half-way leaves the previous frame readable"
     FileSizeLimit limit(kLimit);
     REQUIRE(limit.ok());
     CHECK_THROWS_AS(
-        write_density_vdb(path, DensityInput{large.x.data(), nullptr, large.volume.data(), large.size()}, o),
+        write_density_vdb(
+            path, DensityInput{large.x.data(), nullptr, large.volume.data(), large.size()}, o),
         std::system_error);
   }
   const DensityStats after = read_density_vdb(path);

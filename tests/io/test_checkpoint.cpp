@@ -41,8 +41,8 @@ Checkpoint small_checkpoint() {
   c.time = 2.0 / 24;
   c.particles.keep_plastic = true;
   for (int i = 0; i < 3; ++i) {
-    c.particles.push_back(Vec3(Real(0.1 * i), Real(0.5), Real(-0.2 * i)), Vec3(Real(i), Real(-1), 0),
-                          Real(1.5e-5), 0, Real(0.9 + 0.01 * i));
+    c.particles.push_back(Vec3(Real(0.1 * i), Real(0.5), Real(-0.2 * i)),
+                          Vec3(Real(i), Real(-1), 0), Real(1.5e-5), 0, Real(0.9 + 0.01 * i));
     c.particles.C.back() = Mat3::Constant(Real(0.01 * i));
     c.particles.F.back() = Mat3::Identity() * Real(1 + 0.001 * i);
   }
@@ -259,7 +259,8 @@ TEST_CASE("values no run writes are refused even under a valid checksum", "[chec
   }
 }
 
-TEST_CASE("a checkpoint that does not fit its scene is refused before the solver reads it", "[checkpoint]") {
+TEST_CASE("a checkpoint that does not fit its scene is refused before the solver reads it",
+          "[checkpoint]") {
   TempDir dir("ck_fit");
   const Scene scene = parse_scene(kScene, dir.file("scene.yaml"));
   const std::string path = dir.file("checkpoint.0003.bin");
@@ -283,9 +284,11 @@ TEST_CASE("a checkpoint that does not fit its scene is refused before the solver
   };
   const std::string material = refusal([](Checkpoint& c) { c.particles.material[5] = 1; });
   CHECK(material.find(path) != std::string::npos);
-  CHECK(material.find("particle 5 has material index 1, the scene has 1 materials") != std::string::npos);
-  CHECK(refusal([](Checkpoint& c) { c.particles.material.back() = 65535; }).find("material index 65535") !=
+  CHECK(material.find("particle 5 has material index 1, the scene has 1 materials") !=
         std::string::npos);
+  CHECK(refusal([](Checkpoint& c) {
+          c.particles.material.back() = 65535;
+        }).find("material index 65535") != std::string::npos);
   CHECK(refusal([](Checkpoint& c) {
           c.particles.keep_plastic = true;
           c.particles.plastic.assign(c.particles.size(), 1);
@@ -297,13 +300,14 @@ TEST_CASE("a checkpoint that does not fit its scene is refused before the solver
         std::string::npos);
 }
 
-TEST_CASE("checkpoints are listed newest first; names that are not a frame are skipped with a warning",
-          "[checkpoint]") {
+TEST_CASE(
+    "checkpoints are listed newest first; names that are not a frame are skipped with a warning",
+    "[checkpoint]") {
   TempDir dir("ck_list");
-  for (const char* name : {"checkpoint.0002.bin", "checkpoint.0010.bin", "checkpoint.0004.bin",
-                           "checkpoint.99999999999.bin", "checkpoint.0000.bin",
-                           "checkpoint.000000000007.bin", "checkpoint.old.bin", "checkpoint..bin",
-                           "checkpoint.0003.bin.tmp.12", "density.0001.vdb"})
+  for (const char* name :
+       {"checkpoint.0002.bin", "checkpoint.0010.bin", "checkpoint.0004.bin",
+        "checkpoint.99999999999.bin", "checkpoint.0000.bin", "checkpoint.000000000007.bin",
+        "checkpoint.old.bin", "checkpoint..bin", "checkpoint.0003.bin.tmp.12", "density.0001.vdb"})
     dir.write(name, "x");
   std::vector<std::string> warnings;
   const auto all = list_checkpoints(dir.path.string(), 8, &warnings);
