@@ -4,7 +4,6 @@
 #include <exception>
 
 #include "app/commands.h"
-#include "app/frame_range.h"
 #include "io/user_error.h"
 #include "sim/core/check.h"
 #include "sim/solver/solver.h"
@@ -25,18 +24,6 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
                          "per-frame stage timings and energies");
 }
 
-/// Checks --frames before the scene is read (numbers of any length, named in the message).
-const CLI::Validator kFrameRange(
-    [](std::string& text) {
-      try {
-        parse_frame_range(text);
-      } catch (const std::invalid_argument& e) {
-        return std::string(e.what());
-      }
-      return std::string();
-    },
-    "A-B", "frame range");
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -47,8 +34,7 @@ int main(int argc, char** argv) {
   RunArgs run;
   CLI::App* run_cmd = app.add_subcommand("run", "simulate a scene and write its caches");
   add_common(run_cmd, run);
-  run_cmd->add_option("--frames", run.frames, "frame range A-B (or one frame A)")
-      ->check(kFrameRange);
+  run_cmd->add_option("--frames", run.frames, "frame range A-B (or one frame A)");
   run_cmd->add_option("--output,-o", run.output, "output directory (replaces output.directory)");
   run_cmd->add_flag("--resume", run.resume, "continue from the newest checkpoint in the output directory");
   run_cmd->add_flag("--preview", run.preview,
@@ -63,10 +49,7 @@ int main(int argc, char** argv) {
   CLI::App* render_cmd = app.add_subcommand(
       "render", "render a run's caches to preview.####.png, a contact sheet and an MP4");
   render_cmd->add_option("OUTDIR", render.outdir, "output directory of a `shellmpm run`")->required();
-  render_cmd
-      ->add_option("--frames", render.frames,
-                   "frame range A-B (or one frame A); default: the run's")
-      ->check(kFrameRange);
+  render_cmd->add_option("--frames", render.frames, "frame range A-B (or one frame A); default: the run's");
   render_cmd->add_option("--camera", render.camera, "camera name from render.cameras, or auto");
   render_cmd->add_option("--size", render.size, "image size WxH (e.g. 1280x720)");
   render_cmd->add_option("--renderer", render.renderer, "raster (OpenGL, OSMesa) or raytrace (Embree)")

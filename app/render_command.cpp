@@ -16,13 +16,9 @@ namespace shellmpm {
 namespace {
 
 void parse_frames(const std::string& text, int& a, int& b) {
-  try {
-    const FrameRange r = parse_frame_range(text);
-    a = r.first;
-    b = r.last;
-  } catch (const std::invalid_argument& e) {
-    throw UserError("--frames " + text, 0, "", e.what());
-  }
+  const FrameRange r = parse_frames_flag(text);
+  a = r.first;
+  b = r.last;
 }
 
 void parse_size(const std::string& text, int& w, int& h) {

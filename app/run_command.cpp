@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/frame_range.h"
 #include "app/scene_loading.h"
 #include "app/stop_signals.h"
 #include "io/shot_runner.h"
@@ -15,6 +16,7 @@
 namespace shellmpm {
 
 int run_command(const RunArgs& a) {
+  if (!a.frames.empty()) parse_frames_flag(a.frames);  // before the scene: numbers of any length
   LoadedScene ls = load_scene_for_cli(a, a.frames, a.output);
   const Scene& scene = ls.scene;
   ThreadLimit limit(scene.shot.threads);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "io/atomic_file.h"
@@ -60,15 +61,20 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
 /// name below it (a shell pattern "meshes/{name}.####.ply").
 std::vector<std::string> output_folders(const Scene& scene) {
   const OutputSettings& o = scene.output;
-  std::vector<std::string> files = {frame_path(o.directory, o.density_pattern, 1),
-                                    frame_path(o.directory, o.particles_pattern, 1),
-                                    frame_path(o.directory, scene.render.pattern, 1),
-                                    o.directory + "/" + o.stats_file};
+  std::vector<std::string> patterns = {o.density_pattern, o.particles_pattern, scene.render.pattern};
   for (const ShellDesc& sh : scene.shells) {
     std::string pattern = o.shell_pattern;
     const auto at = pattern.find("{name}");
     if (at != std::string::npos) pattern.replace(at, 6, sh.name);
-    files.push_back(frame_path(o.directory, pattern, 1));
+    patterns.push_back(pattern);
+  }
+  std::vector<std::string> files = {o.directory + "/" + o.stats_file};
+  for (const std::string& p : patterns) {
+    try {
+      files.push_back(frame_path(o.directory, p, 1));
+    } catch (const std::invalid_argument&) {
+      // a pattern the writer would refuse names no folder
+    }
   }
   std::vector<std::string> dirs = {o.directory};
   for (const std::string& f : files) {
@@ -93,7 +99,8 @@ bool find_resume_checkpoint(const Scene& scene, const RunOptions& opt, Checkpoin
   if (files.empty()) return false;
   nlohmann::json damaged = nlohmann::json::array();
   std::string reasons;
-  for (const CheckpointFile& f : files) {
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const CheckpointFile& f = files[i];
     std::string why;
     try {
       ck = read_checkpoint(f.path);
@@ -106,7 +113,7 @@ bool find_resume_checkpoint(const Scene& scene, const RunOptions& opt, Checkpoin
     } catch (const CheckpointDamaged& e) {
       why = e.what();
     }
-    warn(why + "; trying an older checkpoint");
+    warn(why + (i + 1 < files.size() ? "; trying an older checkpoint" : "; no older checkpoint"));
     damaged.push_back({{"file", f.path}, {"error", why}});
     reasons += "\n  " + why;
   }
