@@ -41,6 +41,13 @@ inline Child spawn_shellmpm(const std::vector<std::string>& args, const std::str
       dup2(fd, 1);
       dup2(fd, 2);
     }
+    // A foreground process, whatever the test runner ignores or blocks (a background
+    // job of a non-interactive shell ignores SIGINT).
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
     if (file_size_limit > 0) {
       signal(SIGXFSZ, SIG_IGN);
       rlimit r{};
