@@ -184,7 +184,7 @@ struct Runs {
 
 }  // namespace
 
-TEST_CASE("CLI: a damaged newest checkpoint falls back to the previous one; none intact is exit 2",
+TEST_CASE("CLI: a damaged newest checkpoint falls back to the previous one, none intact is exit 2",
           "[cli][resume][checkpoint]") {
   Runs runs;
   // An intact checkpoint resumes from frame 3 itself.

@@ -95,7 +95,7 @@ void stop_and_resume(const TempDir& d, const std::string& scene, const std::stri
 
 }  // namespace
 
-TEST_CASE("CLI: SIGTERM and SIGINT stop after the frame with a checkpoint; --resume completes it",
+TEST_CASE("CLI: SIGTERM and SIGINT stop after the frame with a checkpoint and --resume completes it",
           "[cli][resume][signals]") {
   TempDir d("stop");
   const std::string s = make_scene(d);
@@ -106,8 +106,8 @@ TEST_CASE("CLI: SIGTERM and SIGINT stop after the frame with a checkpoint; --res
 }
 
 TEST_CASE(
-    "CLI: a write that fails (file size limit, like a full disk) exits 1 naming the file; "
-    "nothing already written changes",
+    "CLI: a write that fails (file size limit, like a full disk) exits 1 naming the file "
+    "and nothing already written changes",
     "[cli][atomic]") {
   TempDir d("disk_full");
   const std::string s = make_scene(d);

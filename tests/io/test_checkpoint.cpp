@@ -301,7 +301,7 @@ TEST_CASE("a checkpoint that does not fit its scene is refused before the solver
 }
 
 TEST_CASE(
-    "checkpoints are listed newest first; names that are not a frame are skipped with a warning",
+    "checkpoints are listed newest first and names that are not a frame are skipped with a warning",
     "[checkpoint]") {
   TempDir dir("ck_list");
   for (const char* name :
