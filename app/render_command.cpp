@@ -4,6 +4,7 @@
 #include <regex>
 
 #include "app/commands.h"
+#include "app/frame_range.h"
 #include "io/scene_reader.h"
 #include "io/user_error.h"
 #include "render/preview_job.h"
@@ -15,13 +16,9 @@ namespace shellmpm {
 namespace {
 
 void parse_frames(const std::string& text, int& a, int& b) {
-  std::smatch m;
-  const std::regex re(R"((\d{1,9})(?:-(\d{1,9}))?)");
-  if (!std::regex_match(text, m, re))
-    throw UserError("--frames " + text, 0, "", "expected A-B or A with frame numbers >= 1");
-  a = std::stoi(m[1]);
-  b = m[2].matched ? std::stoi(m[2]) : a;
-  if (a < 1 || b < a) throw UserError("--frames " + text, 0, "", "need 1 <= A <= B");
+  const FrameRange r = parse_frames_flag(text);
+  a = r.first;
+  b = r.last;
 }
 
 void parse_size(const std::string& text, int& w, int& h) {

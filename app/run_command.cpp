@@ -5,7 +5,9 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/frame_range.h"
 #include "app/scene_loading.h"
+#include "app/stop_signals.h"
 #include "io/shot_runner.h"
 #include "render/preview_job.h"
 #include "render/run_manifest.h"
@@ -14,6 +16,7 @@
 namespace shellmpm {
 
 int run_command(const RunArgs& a) {
+  if (!a.frames.empty()) parse_frames_flag(a.frames);  // before the scene: numbers of any length
   LoadedScene ls = load_scene_for_cli(a, a.frames, a.output);
   const Scene& scene = ls.scene;
   ThreadLimit limit(scene.shot.threads);
@@ -47,10 +50,21 @@ int run_command(const RunArgs& a) {
     po.log = [&](const std::string& m) { progress.message(m); };
     preview = std::make_unique<PreviewJob>(scene, po);
   }
+  StopSignals signals;
+  bool stop_noted = false;
+  auto note_stop = [&](int frame) {
+    if (stop_noted || StopSignals::pending() == 0) return;
+    stop_noted = true;
+    progress.warning(StopSignals::name(StopSignals::pending()) + ": stopping after frame " +
+                     std::to_string(frame) +
+                     " (a checkpoint follows); send it again to stop at once");
+  };
   RunOptions ro;
   ro.resume = a.resume;
   ro.scene_fingerprint = ls.fingerprint;
+  ro.stop_requested = [] { return StopSignals::pending(); };
   ro.on_substep = [&](int f, int s, double dt, double t, std::size_t n) {
+    note_stop(f);
     progress.substep(f, s, dt, t, n);
   };
   ro.on_frame = [&](const FrameStats& s) {
@@ -60,9 +74,19 @@ int run_command(const RunArgs& a) {
   };
   ro.log = [&](const std::string& m) { progress.message(m); };
   ro.warn = [&](const std::string& m) { progress.warning(m); };
-  const int n = run_shot(scene, ro);
+  const RunResult result = run_shot(scene, ro);
   progress.finish();
-  progress.message("wrote " + std::to_string(n) + " frames to " + scene.output.directory);
+  if (result.stopped_by != 0) {
+    // Printed even with --quiet: the job did not finish.
+    std::fprintf(stderr,
+                 "stopped by %s after frame %d (%d frames written to %s); checkpoint '%s' "
+                 "written: run the same command with --resume to continue\n",
+                 StopSignals::name(result.stopped_by).c_str(), result.last_frame,
+                 result.frames_written, scene.output.directory.c_str(), result.checkpoint.c_str());
+    return 128 + result.stopped_by;
+  }
+  progress.message("wrote " + std::to_string(result.frames_written) + " frames to " +
+                   scene.output.directory);
   if (preview) {
     const int failed = preview->finish();
     progress.message("previews: " + preview->image_path(scene.shot.frame_start) + " ... (" +

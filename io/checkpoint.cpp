@@ -1,53 +1,208 @@
 #include "io/checkpoint.h"
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <regex>
+#include <sstream>
 #include <system_error>
 
 #include "io/atomic_file.h"
-#include "io/user_error.h"
+#include "io/checksum.h"
+#include "io/shot_runner.h"
 #include "sim/solver/solver.h"
 
 namespace shellmpm {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '2'};
+constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '3'};
+constexpr char kEndMagic[8] = {'S', 'H', 'M', 'P', 'M', 'E', 'N', 'D'};
+constexpr std::size_t kHeaderBytes = 8 + 4 + 8;  // magic, sizeof(Real), payload size
+constexpr std::size_t kTrailerBytes = 4 + 8;     // CRC-32, end magic
 
-template <class T>
-void put(std::ofstream& f, const T& v) {
-  f.write(reinterpret_cast<const char*>(&v), sizeof(T));
-}
-template <class T>
-void put_vec(std::ofstream& f, const std::vector<T>& v) {
-  put<std::uint64_t>(f, v.size());
-  f.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
-}
+// ---- writing: one serializer, run once to count the payload and once to write it ----
 
-struct Reader {
-  std::ifstream f;
-  std::string path;
-  std::uint64_t file_size = 0;
-  [[noreturn]] void fail(const std::string& what) {
-    throw UserError(path, 0, "", "not a readable shellmpm checkpoint: " + what);
-  }
-  template <class T>
-  T get() {
-    T v;
-    f.read(reinterpret_cast<char*>(&v), sizeof(T));
-    if (!f) fail("file is truncated");
-    return v;
-  }
-  template <class T>
-  void get_vec(std::vector<T>& v, std::uint64_t expect) {
-    const auto n = get<std::uint64_t>();
-    if (n != expect) fail("inconsistent array length");
-    if (n * sizeof(T) > file_size) fail("array longer than the file");
-    v.resize(n);
-    f.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
-    if (!f) fail("file is truncated");
+struct CountingSink {
+  std::uint64_t bytes = 0;
+  void put(const void*, std::size_t n) { bytes += n; }
+};
+
+struct FileSink {
+  CheckedFile& out;
+  Crc32 crc;
+  void put(const void* p, std::size_t n) {
+    out.write(p, n);
+    crc.update(p, n);
   }
 };
+
+template <class T, class Sink>
+void put(Sink& s, const T& v) {
+  s.put(&v, sizeof(T));
+}
+template <class T, class Sink>
+void put_vec(Sink& s, const std::vector<T>& v) {
+  put<std::uint64_t>(s, v.size());
+  s.put(v.data(), v.size() * sizeof(T));
+}
+
+template <class Sink>
+void put_payload(Sink& s, const Checkpoint& c) {
+  put(s, c.scene_fingerprint);
+  put<std::int32_t>(s, c.frame);
+  put(s, c.time);
+  const ParticleSet& p = c.particles;
+  put<std::uint64_t>(s, p.size());
+  put<std::uint32_t>(s, p.next_id);
+  put<std::uint8_t>(s, p.keep_plastic ? 1 : 0);
+  put_vec(s, p.x);
+  put_vec(s, p.v);
+  put_vec(s, p.C);
+  put_vec(s, p.F);
+  put_vec(s, p.volume);
+  put_vec(s, p.material);
+  put_vec(s, p.id);
+  put_vec(s, p.plastic);
+  put<std::uint64_t>(s, c.stats_json.size());
+  s.put(c.stats_json.data(), c.stats_json.size());
+  put<std::uint64_t>(s, c.shells.size());
+  put(s, c.shell_plastic_work);
+  put(s, c.friction_work);
+  for (const auto& sh : c.shells) {
+    put_vec(s, sh.x);
+    put_vec(s, sh.v);
+    put_vec(s, sh.plastic);
+    put_vec(s, sh.C);
+    put_vec(s, sh.a3e);
+  }
+}
+
+// ---- reading: a cursor over the payload that checks every length it is given ----
+
+struct Cursor {
+  const char* p;
+  const char* end;
+  const std::string& path;
+
+  [[noreturn]] void fail(const std::string& what) const { throw CheckpointDamaged(path, what); }
+  std::size_t left() const { return static_cast<std::size_t>(end - p); }
+  void take(void* dst, std::size_t n, const std::string& what) {
+    if (n > left()) fail(what + " runs past the end of the payload");
+    std::memcpy(dst, p, n);
+    p += n;
+  }
+  template <class T>
+  T get(const std::string& what) {
+    T v;
+    take(&v, sizeof(T), what);
+    return v;
+  }
+  /// A length-prefixed array; `expect` (if not ~0) is the length it must have.
+  template <class T>
+  void get_vec(std::vector<T>& v, const std::string& what, std::uint64_t expect = ~0ull) {
+    const auto n = get<std::uint64_t>(what + " length");
+    if (expect != ~0ull && n != expect)
+      fail(what + " has " + std::to_string(n) + " entries, expected " + std::to_string(expect));
+    if (n > left() / sizeof(T))
+      fail(what + " claims " + std::to_string(n) + " entries, more than the file holds");
+    v.resize(n);
+    take(v.data(), n * sizeof(T), what);
+  }
+};
+
+bool finite(Real x) {
+  return std::isfinite(x);
+}
+template <class M>
+bool finite(const M& m) {
+  return m.allFinite();
+}
+template <class T>
+void require_finite(const Cursor& in, const std::vector<T>& v, const std::string& what) {
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!finite(v[i])) in.fail(what + "[" + std::to_string(i) + "] is not finite");
+}
+
+std::string read_whole_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw CheckpointDamaged(path, "cannot open it");
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw CheckpointDamaged(path, "cannot read its size: " + ec.message());
+  std::string bytes(size, '\0');
+  f.read(bytes.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(f.gcount()) != size)
+    throw CheckpointDamaged(path, "cannot read it");
+  return bytes;
+}
+
+void parse_payload(Cursor& in, Checkpoint& c) {
+  c.scene_fingerprint = in.get<std::uint64_t>("scene fingerprint");
+  c.frame = in.get<std::int32_t>("frame");
+  if (c.frame < 1 || c.frame > kMaxFrameNumber)
+    in.fail("frame " + std::to_string(c.frame) + " is out of range");
+  c.time = in.get<double>("time");
+  if (!std::isfinite(c.time) || c.time < 0) in.fail("time is negative or not finite");
+  const auto n = in.get<std::uint64_t>("particle count");
+  ParticleSet& p = c.particles;
+  p.next_id = in.get<std::uint32_t>("next particle id");
+  const auto keep = in.get<std::uint8_t>("plastic flag");
+  if (keep > 1) in.fail("plastic flag is " + std::to_string(keep));
+  p.keep_plastic = keep == 1;
+  in.get_vec(p.x, "particle positions", n);
+  in.get_vec(p.v, "particle velocities", n);
+  in.get_vec(p.C, "particle APIC matrices", n);
+  in.get_vec(p.F, "particle deformation gradients", n);
+  in.get_vec(p.volume, "particle volumes", n);
+  in.get_vec(p.material, "particle materials", n);
+  in.get_vec(p.id, "particle ids", n);
+  in.get_vec(p.plastic, "particle plastic state", p.keep_plastic ? n : 0);
+  require_finite(in, p.x, "particle position");
+  require_finite(in, p.v, "particle velocity");
+  require_finite(in, p.C, "particle APIC matrix");
+  require_finite(in, p.F, "particle deformation gradient");
+  require_finite(in, p.plastic, "particle plastic state");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(p.volume[i] > 0) || !std::isfinite(p.volume[i]))
+      in.fail("particle volume[" + std::to_string(i) + "] is not positive and finite");
+    if (p.id[i] >= p.next_id)
+      in.fail("particle id[" + std::to_string(i) + "] is not below next id " +
+              std::to_string(p.next_id));
+  }
+  const auto len = in.get<std::uint64_t>("statistics length");
+  if (len > in.left()) in.fail("statistics claim more bytes than the file holds");
+  c.stats_json.resize(len);
+  in.take(c.stats_json.data(), len, "statistics");
+  const auto stats = nlohmann::json::parse(c.stats_json, nullptr, /*allow_exceptions=*/false);
+  if (!stats.is_array()) in.fail("statistics are not a JSON array");
+  const auto nshells = in.get<std::uint64_t>("shell count");
+  // Each shell holds five length prefixes at least.
+  if (nshells > in.left() / (5 * sizeof(std::uint64_t)))
+    in.fail("shell count is larger than the file holds");
+  c.shell_plastic_work = in.get<double>("shell plastic work");
+  c.friction_work = in.get<double>("friction work");
+  if (!std::isfinite(c.shell_plastic_work) || !std::isfinite(c.friction_work))
+    in.fail("accumulated work is not finite");
+  c.shells.resize(nshells);
+  for (std::size_t i = 0; i < nshells; ++i) {
+    auto& sh = c.shells[i];
+    const std::string name = "shell " + std::to_string(i);
+    in.get_vec(sh.x, name + " positions");
+    in.get_vec(sh.v, name + " velocities", sh.x.size());
+    in.get_vec(sh.plastic, name + " plastic state");
+    in.get_vec(sh.C, name + " APIC matrices");
+    in.get_vec(sh.a3e, name + " contact normals");
+    require_finite(in, sh.x, name + " position");
+    require_finite(in, sh.v, name + " velocity");
+    require_finite(in, sh.plastic, name + " plastic state");
+    require_finite(in, sh.C, name + " APIC matrix");
+    require_finite(in, sh.a3e, name + " contact normal");
+  }
+  if (in.left() != 0) in.fail(std::to_string(in.left()) + " unexpected bytes after the shells");
+}
 
 }  // namespace
 
@@ -61,96 +216,60 @@ std::uint64_t fingerprint(const std::string& text) {
 }
 
 void write_checkpoint(const std::string& path, const Checkpoint& c) {
-  write_file_atomic(path, [&](const std::string& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    f.write(kMagic, 8);
-    put<std::uint32_t>(f, sizeof(Real));
-    put(f, c.scene_fingerprint);
-    put<std::int32_t>(f, c.frame);
-    put(f, c.time);
-    const ParticleSet& p = c.particles;
-    put<std::uint64_t>(f, p.size());
-    put<std::uint32_t>(f, p.next_id);
-    put<std::uint8_t>(f, p.keep_plastic ? 1 : 0);
-    put_vec(f, p.x);
-    put_vec(f, p.v);
-    put_vec(f, p.C);
-    put_vec(f, p.F);
-    put_vec(f, p.volume);
-    put_vec(f, p.material);
-    put_vec(f, p.id);
-    put_vec(f, p.plastic);
-    put<std::uint64_t>(f, c.stats_json.size());
-    f.write(c.stats_json.data(), static_cast<std::streamsize>(c.stats_json.size()));
-    put<std::uint64_t>(f, c.shells.size());
-    put(f, c.shell_plastic_work);
-    put(f, c.friction_work);
-    for (const auto& sh : c.shells) {
-      put<std::uint64_t>(f, sh.x.size());
-      put_vec(f, sh.x);
-      put_vec(f, sh.v);
-      put<std::uint64_t>(f, sh.plastic.size());
-      put_vec(f, sh.plastic);
-      put<std::uint64_t>(f, sh.C.size());
-      put_vec(f, sh.C);
-      put<std::uint64_t>(f, sh.a3e.size());
-      put_vec(f, sh.a3e);
-    }
-    f.write(kMagic, 8);
-    if (!f) throw std::system_error(errno, std::generic_category(), "writing " + tmp);
+  CountingSink count;
+  put_payload(count, c);
+  write_stream_atomic(path, [&](CheckedFile& out) {
+    FileSink s{out, {}};
+    s.put(kMagic, 8);
+    put<std::uint32_t>(s, sizeof(Real));
+    put<std::uint64_t>(s, count.bytes);
+    put_payload(s, c);
+    const std::uint32_t crc = s.crc.value();
+    out.write(&crc, sizeof crc);
+    out.write(kEndMagic, 8);
   });
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
-  Reader r;
-  r.path = path;
-  r.f.open(path, std::ios::binary);
-  if (!r.f) throw UserError(path, 0, "", "cannot open checkpoint");
-  std::error_code ec;
-  r.file_size = std::filesystem::file_size(path, ec);
-  char magic[8];
-  r.f.read(magic, 8);
-  if (!r.f || std::string(magic, 8) != std::string(kMagic, 8)) r.fail("bad magic");
-  if (r.get<std::uint32_t>() != sizeof(Real))
-    r.fail("written by a build with a different floating-point precision");
-  Checkpoint c;
-  c.scene_fingerprint = r.get<std::uint64_t>();
-  c.frame = r.get<std::int32_t>();
-  c.time = r.get<double>();
-  const auto n = r.get<std::uint64_t>();
-  ParticleSet& p = c.particles;
-  p.next_id = r.get<std::uint32_t>();
-  p.keep_plastic = r.get<std::uint8_t>() != 0;
-  r.get_vec(p.x, n);
-  r.get_vec(p.v, n);
-  r.get_vec(p.C, n);
-  r.get_vec(p.F, n);
-  r.get_vec(p.volume, n);
-  r.get_vec(p.material, n);
-  r.get_vec(p.id, n);
-  r.get_vec(p.plastic, p.keep_plastic ? n : 0);
-  const auto len = r.get<std::uint64_t>();
-  if (len > r.file_size) r.fail("statistics longer than the file");
-  c.stats_json.resize(len);
-  r.f.read(c.stats_json.data(), static_cast<std::streamsize>(len));
-  const auto nshells = r.get<std::uint64_t>();
-  if (nshells > 1000000) r.fail("bad shell count");
-  c.shell_plastic_work = r.get<double>();
-  c.friction_work = r.get<double>();
-  c.shells.resize(nshells);
-  for (auto& sh : c.shells) {
-    const auto np = r.get<std::uint64_t>();
-    r.get_vec(sh.x, np);
-    r.get_vec(sh.v, np);
-    const auto npl = r.get<std::uint64_t>();
-    r.get_vec(sh.plastic, npl);
-    const auto nC = r.get<std::uint64_t>();
-    r.get_vec(sh.C, nC);
-    const auto na = r.get<std::uint64_t>();
-    r.get_vec(sh.a3e, na);
+  const std::string bytes = read_whole_file(path);
+  auto damaged = [&](const std::string& what) { return CheckpointDamaged(path, what); };
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) {
+    if (bytes.size() >= 8 && std::memcmp(bytes.data(), kMagic, 7) == 0)
+      throw damaged("written in another checkpoint format (" + bytes.substr(0, 8) +
+                    "); resume needs a checkpoint written by this version");
+    throw damaged("not a shellmpm checkpoint (bad magic)");
   }
-  r.f.read(magic, 8);
-  if (!r.f || std::string(magic, 8) != std::string(kMagic, 8)) r.fail("missing end marker");
+  if (bytes.size() < kHeaderBytes + kTrailerBytes)
+    throw damaged("truncated: the header is incomplete");
+  std::uint32_t real_size;
+  std::uint64_t payload;
+  std::memcpy(&real_size, bytes.data() + 8, 4);
+  std::memcpy(&payload, bytes.data() + 12, 8);
+  if (payload != bytes.size() - kHeaderBytes - kTrailerBytes)
+    throw damaged("the file has " + std::to_string(bytes.size()) + " bytes, its header says " +
+                  (payload > bytes.size()
+                       ? std::string("more")
+                       : std::to_string(payload + kHeaderBytes + kTrailerBytes)) +
+                  " (truncated, extended or damaged)");
+  const char* trailer = bytes.data() + kHeaderBytes + payload;
+  if (std::memcmp(trailer + 4, kEndMagic, 8) != 0) throw damaged("missing end marker");
+  std::uint32_t stored;
+  std::memcpy(&stored, trailer, 4);
+  const std::uint32_t actual = crc32(bytes.data(), kHeaderBytes + payload);
+  if (stored != actual) {
+    std::ostringstream os;
+    os << "checksum mismatch (stored " << std::hex << stored << ", computed " << actual
+       << "): the file was changed after it was written";
+    throw damaged(os.str());
+  }
+  if (real_size != sizeof(Real))
+    throw UserError(path, 0, "",
+                    "checkpoint written by a build with " + std::to_string(real_size * 8) +
+                        "-bit floats; this build uses " + std::to_string(sizeof(Real) * 8) +
+                        " (SHELLMPM_DOUBLE): resume with the build that wrote it");
+  Checkpoint c;
+  Cursor in{bytes.data() + kHeaderBytes, trailer, path};
+  parse_payload(in, c);
   return c;
 }
 
@@ -171,45 +290,91 @@ void save_shells(const Solver& solver, Checkpoint& c) {
   c.friction_work = solver.friction_work();
 }
 
-void restore_shells(Solver& solver, const Checkpoint& c) {
+void restore_checkpoint(Solver& solver, Checkpoint&& c, const std::string& path) {
+  auto refuse = [&](const std::string& what) {
+    return UserError(path, 0, "", "checkpoint does not fit the scene: " + what);
+  };
+  const Scene& scene = solver.scene();
+  const ParticleSet& p = c.particles;
+  const std::size_t nmat = scene.materials.size();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.material[i] >= nmat)
+      throw refuse("particle " + std::to_string(i) + " has material index " +
+                   std::to_string(p.material[i]) + ", the scene has " + std::to_string(nmat) +
+                   " materials");
+  if (p.keep_plastic != solver.particles().keep_plastic)
+    throw refuse(p.keep_plastic ? "it has plastic state the scene's materials do not use"
+                                : "it has no plastic state, the scene's materials need one");
+  const double expected = frame_time(c.frame, scene.shot.fps);
+  if (!(std::abs(c.time - expected) <= 0.5 / scene.shot.fps))
+    throw refuse("its time " + std::to_string(c.time) + " s is not that of frame " +
+                 std::to_string(c.frame) + " (" + std::to_string(expected) + " s)");
   auto& shells = solver.shells();
   if (c.shells.size() != shells.size())
-    throw UserError("checkpoint", 0, "", "shell count differs from the scene");
+    throw refuse("it has " + std::to_string(c.shells.size()) + " shells, the scene " +
+                 std::to_string(shells.size()));
   for (std::size_t i = 0; i < shells.size(); ++i) {
-    if (c.shells[i].x.size() != shells[i]->size())
-      throw UserError("checkpoint", 0, "", "shell '" + shells[i]->name() + "' has another size");
+    const auto& st = c.shells[i];
+    const std::string name = "shell '" + shells[i]->name() + "'";
+    if (st.x.size() != shells[i]->size() ||
+        st.plastic.size() != shells[i]->kl().plastic_state().size())
+      throw refuse(name + " has another size (did its mesh file change?)");
+    const ShellContact* ct = solver.contact(i);
+    const std::size_t nC = ct ? ct->C.size() : 0, na = ct ? ct->a3e.size() : 0;
+    if (st.C.size() != nC || st.a3e.size() != na) throw refuse(name + " has other contact data");
+  }
+  for (std::size_t i = 0; i < shells.size(); ++i) {
     shells[i]->x = c.shells[i].x;
     shells[i]->v = c.shells[i].v;
     shells[i]->kl().set_plastic_state(c.shells[i].plastic);
     if (ShellContact* ct = solver.contact(i)) {
-      if (c.shells[i].C.size() != ct->C.size() || c.shells[i].a3e.size() != ct->a3e.size())
-        throw UserError("checkpoint", 0, "", "shell '" + shells[i]->name() + "' has other contact data");
       ct->C = c.shells[i].C;
       ct->a3e = c.shells[i].a3e;
     }
   }
   solver.set_shell_plastic_work(c.shell_plastic_work);
   solver.set_friction_work(c.friction_work);
+  solver.particles() = std::move(c.particles);
+  solver.set_time(c.time);
+}
+
+std::vector<CheckpointFile> list_checkpoints(const std::string& dir, int max_frame,
+                                             std::vector<std::string>* warnings) {
+  namespace fs = std::filesystem;
+  std::vector<CheckpointFile> found;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return found;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    constexpr std::size_t kPrefix = 11, kSuffix = 4;  // "checkpoint." and ".bin"
+    if (name.size() <= kPrefix + kSuffix || name.compare(0, kPrefix, "checkpoint.") != 0 ||
+        name.compare(name.size() - kSuffix, kSuffix, ".bin") != 0)
+      continue;
+    const std::string digits = name.substr(kPrefix, name.size() - kPrefix - kSuffix);
+    if (!std::all_of(digits.begin(), digits.end(), [](char ch) { return ch >= '0' && ch <= '9'; }))
+      continue;  // not one of ours ("checkpoint.old.bin")
+    // Up to 9 digits always fit an int; more only with leading zeros.
+    const auto nz = digits.find_first_not_of('0');
+    const std::string significant = nz == std::string::npos ? "0" : digits.substr(nz);
+    const long long f = significant.size() <= 9 ? std::stoll(significant) : -1;
+    if (f < 1 || f > kMaxFrameNumber) {
+      if (warnings)
+        warnings->push_back("ignoring '" + e.path().string() + "': " + digits +
+                            " is not a frame number (1 to " + std::to_string(kMaxFrameNumber) +
+                            ")");
+      continue;
+    }
+    if (f <= max_frame) found.push_back({e.path().string(), static_cast<int>(f)});
+  }
+  std::sort(found.begin(), found.end(), [](const CheckpointFile& a, const CheckpointFile& b) {
+    return a.frame != b.frame ? a.frame > b.frame : a.path < b.path;
+  });
+  return found;
 }
 
 std::string latest_checkpoint(const std::string& dir, int max_frame) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return "";
-  const std::regex re(R"(checkpoint\.(\d+)\.bin)");
-  int best = -1;
-  std::string best_path;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    std::smatch m;
-    const std::string name = e.path().filename().string();
-    if (!std::regex_match(name, m, re)) continue;
-    const int f = std::stoi(m[1]);
-    if (f <= max_frame && f > best) {
-      best = f;
-      best_path = e.path().string();
-    }
-  }
-  return best_path;
+  const auto all = list_checkpoints(dir, max_frame);
+  return all.empty() ? "" : all.front().path;
 }
 
 }  // namespace shellmpm

@@ -75,6 +75,18 @@ std::string describe(const Vec3& x) {
   return os.str();
 }
 
+/// What openvdb::io::File::write does (a seekable archive, so readers get the grid
+/// offsets), but onto a stream we give it: io::File writes through its own std::ofstream
+/// and never checks it, which left truncated files behind on a full disk. Our stream is
+/// a CheckedFile, whose close() reports any failed write.
+class VdbFileWriter : public openvdb::io::Archive {
+ public:
+  void write_file(std::ostream& os, const openvdb::GridPtrVec& grids,
+                  const openvdb::MetaMap& meta) const {
+    Archive::write(os, grids, /*seekable=*/true, meta);
+  }
+};
+
 void add_metadata(openvdb::MetaMap& m, const VdbOptions& o) {
   m.insertMeta("frame", openvdb::Int32Metadata(o.frame));
   m.insertMeta("time", openvdb::FloatMetadata(static_cast<float>(o.time)));
@@ -284,12 +296,10 @@ void write_density_vdb(const std::string& path, const DensityInput& in, const Vd
 
   openvdb::MetaMap file_meta;
   add_metadata(file_meta, o);
-  write_file_atomic(path, [&](const std::string& tmp) {
-    openvdb::io::File file(tmp);
-    file.setCompression(compression_flags());
-    file.write(grids, file_meta);
-    file.close();
-  });
+  VdbFileWriter archive;
+  archive.setCompression(compression_flags());
+  write_stream_atomic(
+      path, [&](CheckedFile& out) { archive.write_file(out.stream(), grids, file_meta); });
 }
 
 DensityStats read_density_vdb(const std::string& path) {

@@ -1,8 +1,6 @@
 #include "io/particle_cache.h"
 
 #include <cstring>
-#include <fstream>
-#include <system_error>
 #include <vector>
 
 #include "io/atomic_file.h"
@@ -23,11 +21,9 @@ void write_particle_ply(const std::string& path, const ParticleSet& p) {
     std::memcpy(body.data() + i * kRecord, r, 24);
     std::memcpy(body.data() + i * kRecord + 24, &p.id[i], 4);
   }
-  write_file_atomic(path, [&](const std::string& tmp) {
-    std::ofstream f(tmp, std::ios::binary);
-    f.write(header.data(), static_cast<std::streamsize>(header.size()));
-    f.write(body.data(), static_cast<std::streamsize>(body.size()));
-    if (!f) throw std::system_error(errno, std::generic_category(), "writing " + tmp);
+  write_stream_atomic(path, [&](CheckedFile& out) {
+    out.write(header.data(), header.size());
+    out.write(body.data(), body.size());
   });
 }
 

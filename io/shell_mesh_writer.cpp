@@ -1,14 +1,12 @@
 #include "io/shell_mesh_writer.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
-#include <system_error>
 #include <vector>
 
 #include "io/atomic_file.h"
@@ -90,16 +88,6 @@ Attributes gather(const MeshFrame& m) {
       for (int k = 0; k < 2; ++k) a.uvs[2 * v + k] = static_cast<float>(m.uvs[v][k]);
   }
   return a;
-}
-
-void write_whole_file(const std::string& path, const std::string& bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) throw std::system_error(errno, std::generic_category(), "cannot create '" + path + "'");
-  const std::size_t written = std::fwrite(bytes.data(), 1, bytes.size(), f);
-  const int write_errno = errno;
-  if (std::fclose(f) != 0 || written != bytes.size())
-    throw std::system_error(written != bytes.size() ? write_errno : errno, std::generic_category(),
-                            "cannot write '" + path + "'");
 }
 
 template <class T>
@@ -340,7 +328,7 @@ void write_shell_mesh(const std::string& path, const MeshFrame& mesh, MeshFormat
       bytes = encode_glb(mesh, a);
       break;
   }
-  write_file_atomic(path, [&](const std::string& tmp) { write_whole_file(tmp, bytes); });
+  write_bytes_atomic(path, bytes.data(), bytes.size());
 }
 
 }  // namespace shellmpm

@@ -1,7 +1,10 @@
 #include "io/shot_runner.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
+#include <vector>
 
 #include "io/atomic_file.h"
 #include "io/checkpoint.h"
@@ -54,14 +57,100 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
   }
 }
 
+/// The folders a run writes into: the output directory and those the file patterns
+/// name below it (a shell pattern "meshes/{name}.####.ply").
+std::vector<std::string> output_folders(const Scene& scene) {
+  const OutputSettings& o = scene.output;
+  std::vector<std::string> patterns = {o.density_pattern, o.particles_pattern, scene.render.pattern};
+  for (const ShellDesc& sh : scene.shells) {
+    std::string pattern = o.shell_pattern;
+    const auto at = pattern.find("{name}");
+    if (at != std::string::npos) pattern.replace(at, 6, sh.name);
+    patterns.push_back(pattern);
+  }
+  std::vector<std::string> files = {o.directory + "/" + o.stats_file};
+  for (const std::string& p : patterns) {
+    try {
+      files.push_back(frame_path(o.directory, p, 1));
+    } catch (const std::invalid_argument&) {
+      // a pattern the writer would refuse names no folder
+    }
+  }
+  std::vector<std::string> dirs = {o.directory};
+  for (const std::string& f : files) {
+    const std::string d = std::filesystem::path(f).parent_path().string();
+    if (!d.empty() && std::find(dirs.begin(), dirs.end(), d) == dirs.end()) dirs.push_back(d);
+  }
+  return dirs;
+}
+
+/// The newest intact checkpoint in the output directory. Damaged ones are skipped with
+/// a warning and listed in `resume_note`. Returns false when there is none at all.
+bool find_resume_checkpoint(const Scene& scene, const RunOptions& opt, Checkpoint& ck,
+                            std::string& path, nlohmann::json& resume_note) {
+  const OutputSettings& out = scene.output;
+  auto warn = [&](const std::string& m) {
+    if (opt.warn) opt.warn(m);
+  };
+  std::vector<std::string> warnings;
+  const std::vector<CheckpointFile> files =
+      list_checkpoints(out.directory, scene.shot.frame_end, &warnings);
+  for (const std::string& w : warnings) warn(w);
+  if (files.empty()) return false;
+  nlohmann::json damaged = nlohmann::json::array();
+  std::string reasons;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const CheckpointFile& f = files[i];
+    std::string why;
+    try {
+      ck = read_checkpoint(f.path);
+      if (ck.frame == f.frame) {
+        path = f.path;
+        break;
+      }
+      why = f.path + ": holds frame " + std::to_string(ck.frame) + ", its name says " +
+            std::to_string(f.frame);
+    } catch (const CheckpointDamaged& e) {
+      why = e.what();
+    }
+    warn(why + (i + 1 < files.size() ? "; trying an older checkpoint" : "; no older checkpoint"));
+    damaged.push_back({{"file", f.path}, {"error", why}});
+    reasons += "\n  " + why;
+  }
+  if (path.empty())
+    throw UserError(out.directory, 0, "",
+                    "no intact checkpoint to resume from (" + std::to_string(files.size()) +
+                        " damaged):" + reasons +
+                        "\ndelete them to start again from frame 1, or run without --resume");
+  resume_note = {{"checkpoint", path}, {"frame", ck.frame}};
+  if (!damaged.empty()) {
+    resume_note["damaged"] = damaged;
+    warn("resuming from the older checkpoint '" + path + "' (frame " + std::to_string(ck.frame) +
+         "): " + std::to_string(damaged.size()) + " newer one(s) damaged");
+  }
+  return true;
+}
+
+Checkpoint capture(const Solver& solver, const StatsFile& stats, int frame, std::uint64_t fp) {
+  Checkpoint c;
+  c.scene_fingerprint = fp;
+  c.frame = frame;
+  c.time = solver.time();
+  c.particles = solver.particles();
+  save_shells(solver, c);
+  c.stats_json = stats.frames().dump();
+  return c;
+}
+
 }  // namespace
 
-int run_shot(const Scene& scene, const RunOptions& opt) {
+RunResult run_shot(const Scene& scene, const RunOptions& opt) {
   const ShotSettings& shot = scene.shot;
   const OutputSettings& out = scene.output;
   auto log = [&](const std::string& m) {
     if (opt.log) opt.log(m);
   };
+  auto stop = [&]() { return opt.stop_requested ? opt.stop_requested() : 0; };
   std::error_code ec;
   std::filesystem::create_directories(out.directory, ec);
   if (ec || !std::filesystem::is_directory(out.directory))
@@ -72,21 +161,25 @@ int run_shot(const Scene& scene, const RunOptions& opt) {
   so.serial = opt.serial;
   int first_frame = 1;
   Checkpoint ck;
+  std::string ck_path;
+  nlohmann::json resume_note;
   bool resumed = false;
   if (opt.resume) {
-    const std::string path = latest_checkpoint(out.directory, shot.frame_end);
-    if (path.empty()) {
+    int removed = 0;
+    for (const std::string& d : output_folders(scene)) removed += remove_atomic_temps(d);
+    if (removed > 0)
+      log("removed " + std::to_string(removed) + " temporary file(s) left by a killed run");
+    if (!find_resume_checkpoint(scene, opt, ck, ck_path, resume_note)) {
       log("no checkpoint in '" + out.directory + "': starting from frame 1");
     } else {
-      ck = read_checkpoint(path);
       if (ck.scene_fingerprint != opt.scene_fingerprint)
-        throw UserError(path, 0, "",
+        throw UserError(ck_path, 0, "",
                         "checkpoint was written for a different scene or --set overrides; "
                         "delete it or run without --resume");
       so.fill_sources = false;
       resumed = true;
       first_frame = ck.frame + 1;
-      log("resuming after frame " + std::to_string(ck.frame) + " from '" + path + "'");
+      log("resuming after frame " + std::to_string(ck.frame) + " from '" + ck_path + "'");
     }
   }
   Solver solver(scene, so);
@@ -96,19 +189,18 @@ int run_shot(const Scene& scene, const RunOptions& opt) {
   header["fps"] = shot.fps;
   header["transfer"] = shot.transfer;
   header["stages"] = solver.stage_names();
+  if (resumed) header["resume"] = resume_note;
   StatsFile stats(out.directory + "/" + out.stats_file, header);
   if (!resumed && scene.preroll.enabled) {
     const int steps = solver.preroll(scene.preroll);
     log("pre-roll settled the shells in " + std::to_string(steps) + " steps");
   }
   if (resumed) {
-    restore_shells(solver, ck);
-    solver.particles() = std::move(ck.particles);
-    solver.set_time(ck.time);
     stats.set_frames(nlohmann::json::parse(ck.stats_json));
+    restore_checkpoint(solver, std::move(ck), ck_path);
   }
 
-  int written = 0;
+  RunResult result;
   for (int frame = first_frame; frame <= shot.frame_end; ++frame) {
     const double t_end = frame_time(frame, shot.fps);
     FrameStats fs;
@@ -122,6 +214,7 @@ int run_shot(const Scene& scene, const RunOptions& opt) {
       });
     }
     fs.frame = frame;
+    result.last_frame = frame;
     if (!fs.integrity.events.empty()) {
       const std::vector<std::string> lines = describe_integrity(fs.integrity, frame, shot.dx);
       for (const std::string& l : lines)
@@ -138,21 +231,22 @@ int run_shot(const Scene& scene, const RunOptions& opt) {
       write_frame_outputs(scene, solver, frame);
       stats.add(fs);
       stats.write();
-      ++written;
+      ++result.frames_written;
     }
-    if (out.checkpoint_every > 0 && frame % out.checkpoint_every == 0) {
-      Checkpoint c;
-      c.scene_fingerprint = opt.scene_fingerprint;
-      c.frame = frame;
-      c.time = solver.time();
-      c.particles = solver.particles();
-      save_shells(solver, c);
-      c.stats_json = stats.frames().dump();
-      write_checkpoint(frame_path(out.directory, "checkpoint.####.bin", frame), c);
+    const int signal = stop();
+    const bool periodic = out.checkpoint_every > 0 && frame % out.checkpoint_every == 0;
+    if (periodic || (signal != 0 && frame < shot.frame_end)) {
+      const std::string path = frame_path(out.directory, "checkpoint.####.bin", frame);
+      write_checkpoint(path, capture(solver, stats, frame, opt.scene_fingerprint));
+      if (signal != 0) result.checkpoint = path;
     }
     if (opt.on_frame) opt.on_frame(fs);
+    if (signal != 0 && frame < shot.frame_end) {
+      result.stopped_by = signal;
+      break;
+    }
   }
-  return written;
+  return result;
 }
 
 }  // namespace shellmpm

@@ -23,13 +23,36 @@ struct RunOptions {
   std::function<void(const std::string&)> warn;
   /// Informational messages.
   std::function<void(const std::string&)> log;
+  /// Polled after every substep and frame: a non-zero value (the number of the signal
+  /// that asked for it) stops the run once the frame being computed is finished and
+  /// written; a checkpoint of that frame is written (whatever output.checkpoint_every
+  /// says) so that --resume continues from it.
+  std::function<int()> stop_requested;
 };
+
+/// What run_shot did.
+struct RunResult {
+  int frames_written = 0;
+  int last_frame = 0;      ///< the last frame simulated (0 if none)
+  int stopped_by = 0;      ///< stop_requested's value when the run stopped early, else 0
+  std::string checkpoint;  ///< the checkpoint written when it stopped early
+};
+
+/// The largest frame number --frames and checkpoint names accept (9 digits, so frame
+/// arithmetic stays far from int's limit).
+constexpr int kMaxFrameNumber = 999999999;
 
 /// Time of a frame's state [s].
 inline double frame_time(int frame, double fps) { return (frame - 1) / fps; }
 
 /// Simulates scene.shot.frame_start..frame_end (simulating from frame 1, or from the
-/// checkpoint), writing outputs into scene.output.directory. Returns frames written.
-int run_shot(const Scene& scene, const RunOptions& opt);
+/// checkpoint), writing outputs into scene.output.directory.
+///
+/// With opt.resume: leftover temporaries of a killed run ("*.tmp.<pid>") are removed
+/// from the output folders, and the run continues from the newest intact checkpoint;
+/// a damaged newer one is reported through opt.warn, recorded in stats.json under
+/// "resume" and skipped. No intact checkpoint among several damaged ones is a UserError;
+/// none at all starts from frame 1. A checkpoint of another scene is a UserError.
+RunResult run_shot(const Scene& scene, const RunOptions& opt);
 
 }  // namespace shellmpm
