@@ -45,7 +45,7 @@ bool has(const std::string& text, const std::string& part) {
 
 }  // namespace
 
-TEST_CASE("CLI: check warns when one short mesh edge sets the step; run names it",
+TEST_CASE("CLI: check warns when one short mesh edge sets the step, and run names it",
           "[cli][step_limits]") {
   TempDir d("cli_short_edge");
   d.write("film.obj", film_obj());
@@ -77,7 +77,7 @@ TEST_CASE("CLI: check warns when one short mesh edge sets the step; run names it
   REQUIRE(has(r.output, "merge the vertices of that edge"));
 }
 
-TEST_CASE("CLI: check warns when a steel material sets the step; run names it",
+TEST_CASE("CLI: check warns when a steel material sets the step, and run names it",
           "[cli][step_limits]") {
   TempDir d("cli_steel");
   const std::string s = scene(d,

@@ -50,7 +50,7 @@ TEST_CASE("friction takes c_F times the normal approach off the slip, or sticks"
   CHECK((vb - va).norm() < 1e-6);
 }
 
-TEST_CASE("a pinned field (inverse mass 0) does not move; the other takes it all",
+TEST_CASE("a pinned field (inverse mass 0) does not move, and the other takes it all",
           "[field_contact]") {
   const Vec3 n(1, 0, 0);
   Vec3 va(0.5, 0, 0), vb(-1, 0.25, 0);

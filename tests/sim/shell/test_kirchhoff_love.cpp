@@ -419,7 +419,7 @@ TEST_CASE("KL stretch term: forces are the gradient of the energy past the limit
   }
 }
 
-TEST_CASE("KL stretch term: float matches double; nothing changes below the limit",
+TEST_CASE("KL stretch term: float matches double, and nothing changes below the limit",
           "[kl][membrane_stretch]") {
   std::mt19937 rng(5);
   const BezierShell s = make_bezier_grid(2, 3, 6);

@@ -92,7 +92,7 @@ TEST_CASE("procedural shell meshes: counts, orientation, no mesh problems", "[sh
   }
 }
 
-TEST_CASE("a free shell falls with g and stays unstressed; a curved one too", "[shell]") {
+TEST_CASE("a free shell falls with g and stays unstressed, and so does a curved one", "[shell]") {
   for (int kind = 0; kind < 2; ++kind) {
     ShellDesc sh;
     sh.name = "s";
@@ -253,7 +253,7 @@ TEST_CASE("pre-roll settles a pinned sheet and output meshes keep their layout",
   REQUIRE(lm.uvs().size() == lm.num_vertices());
 }
 
-TEST_CASE("Rayleigh stiffness damping removes energy; without it energy is kept", "[shell]") {
+TEST_CASE("Rayleigh stiffness damping removes energy, and without it energy is kept", "[shell]") {
   auto final_energy = [](double beta) {
     ShellMaterialDesc m = cloth();
     m.stiffness_damping = beta;
