@@ -8,171 +8,21 @@
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
 #include "sim/shell/denting.h"
+#include "sim/shell/kl_kinematics.h"
+#include "sim/shell/laminate_energy.h"
 #include "sim/shell/shell_quadrature.h"
 
 namespace shellmpm {
 namespace {
-
-constexpr std::size_t kPointGrain = 256;    // quadrature points per chunk
 constexpr std::size_t kGatherGrain = 1024;  // control points per chunk
-
-/// Mid-surface kinematics at one quadrature point (supplement sec. 1):
-/// a_a, a_ab, a_3, atilde_a = (a_1,a x a_2 + a_1 x a_2,a) / |a_1 x a_2|, and
-/// v_a = a_3,a = (I - a_3 a_3^T) atilde_a.
-template <class T>
-struct PointKinematics {
-  using V3 = Eigen::Matrix<T, 3, 1>;
-  V3 a1, a2, a11, a12, a22, a3, t1, t2, v1, v2;
-  T inv_l;
-};
-
-template <class T>
-inline void compute_kinematics(PointKinematics<T>& k) {
-  using V3 = Eigen::Matrix<T, 3, 1>;
-  const V3 n = k.a1.cross(k.a2);
-  k.inv_l = T(1) / n.norm();
-  k.a3 = n * k.inv_l;
-  k.t1 = (k.a11.cross(k.a2) + k.a1.cross(k.a12)) * k.inv_l;
-  k.t2 = (k.a12.cross(k.a2) + k.a1.cross(k.a22)) * k.inv_l;
-  k.v1 = k.t1 - k.a3 * k.a3.dot(k.t1);
-  k.v2 = k.t2 - k.a3 * k.a3.dot(k.t2);
-}
-
-/// a_alpha and a_alphabeta at quadrature point q (entries [begin[q], begin[q+1]) with 5
-/// weights each), then the rest of the kinematics. The derivative weights of a point sum
-/// to zero (partition of unity), so the sums run over differences to the point's first
-/// control point: in float this keeps a_alpha and the small a_alphabeta accurate far
-/// from the origin.
-template <class T>
-void gather_kinematics(const std::vector<std::size_t>& begin, const std::vector<int>& ctrl,
-                       const std::vector<T>& coef, std::size_t q,
-                       const Eigen::Matrix<T, 3, 1>* x, PointKinematics<T>& k) {
-  k.a1.setZero();
-  k.a2.setZero();
-  k.a11.setZero();
-  k.a12.setZero();
-  k.a22.setZero();
-  const Eigen::Matrix<T, 3, 1>& x0 = x[ctrl[begin[q]]];
-  for (std::size_t e = begin[q] + 1; e < begin[q + 1]; ++e) {
-    const Eigen::Matrix<T, 3, 1> dx = x[ctrl[e]] - x0;
-    const T* c = &coef[5 * e];
-    k.a1 += c[0] * dx;
-    k.a2 += c[1] * dx;
-    k.a11 += c[2] * dx;
-    k.a12 += c[3] * dx;
-    k.a22 += c[4] * dx;
-  }
-  compute_kinematics(k);
-}
-
-/// atanh(x) / x for x in [0, 1).
-template <class T>
-inline T atanh_over_x(T x) {
-  if (x < T(1e-2)) {
-    const T x2 = x * x;
-    return T(1) + x2 * (T(1) / T(3) + x2 * (T(1) / T(5) + x2 * (T(1) / T(7))));
-  }
-  return std::atanh(x) / x;
-}
-
-/// Laminate energy density of one layer (supplement secs. 3-4) from the current metric
-/// M = [g_a . g_b] (m11, m12, m22) and Bp (row-major 2x2): C = Bp^T M Bp has eigenvalues
-/// s_a^2 and psi = mu/4 |log C|^2 + lambda/8 (log det C)^2 = mu |log s|^2 +
-/// lambda/2 (tr log s)^2, plus the large-stretch term k sum_a (s_a - s_l)_+^2 (our addition,
-/// kirchhoff_love.h). If S != nullptr writes dpsi/dM (s11, s12, s22; symmetric,
-/// dpsi = sum_ab S_ab dM_ab).
-/// log C = alpha I + beta C with beta = (log c1 - log c2) / (c1 - c2) evaluated as
-/// 2 atanh(x) / (x tr), x = (c1 - c2) / (c1 + c2), which is stable at c1 = c2, and
-/// dpsi/dC = C^-1 (mu/2 log C + lambda/4 log det C I).
-/// The stretch term is a spectral function of C: with g_a = dpsi_s/dc_a = k (s_a - s_l)_+ /
-/// s_a, its gradient is g_1 P_1 + g_2 P_2 = a I + b C, b = (g_1 - g_2) / (c_1 - c_2),
-/// a = g_2 - b c_2. Both s_a > s_l: b = k s_l / (s_1 s_2 (s_1 + s_2)) exactly (no
-/// cancellation at s_1 = s_2). Only s_1 > s_l >= s_2: c_1 - c_2 = 2h >= s_1^2 - s_l^2 > 0.
-template <class T, class Stiffening>
-inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m12, T m22, T* S) {
-  // Columns of Bp: (Bp[0], Bp[2]) and (Bp[1], Bp[3]).
-  const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
-  const T mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
-  const T mb1x = m11 * b01 + m12 * b11, mb1y = m12 * b01 + m22 * b11;
-  const T c11 = b00 * mb0x + b10 * mb0y;
-  const T c12 = b00 * mb1x + b10 * mb1y;
-  const T c22 = b01 * mb1x + b11 * mb1y;
-  const T tr = c11 + c22;
-  const T det = c11 * c22 - c12 * c12;
-  const T hd = T(0.5) * (c11 - c22);
-  const T h = std::sqrt(hd * hd + c12 * c12);
-  const T x = T(2) * h / tr;
-  const T q = atanh_over_x(x);
-  const T L = std::log(det);  // log c1 + log c2
-  const T D = T(2) * x * q;   // log c1 - log c2
-  T psi = T(0.125) * mu * (L * L + D * D) + T(0.125) * lambda * L * L;
-  // Large-stretch term; l1 = log s1 >= l2 = log s2. Untaken below the limit (bitwise Hencky).
-  const bool beyond = T(0.25) * (L + D) > st.log_limit;
-  T stretch_i = 0, stretch_c = 0;  // its gradient in C: stretch_i I + stretch_c C
-  if (beyond) {
-    const T s1 = std::exp(T(0.25) * (L + D)), s2 = std::exp(T(0.25) * (L - D));
-    const T d1 = std::max(s1 - st.limit, T(0));
-    const T g1 = st.k * d1 / s1;
-    if (s2 > st.limit) {
-      const T d2 = s2 - st.limit;
-      psi += st.k * (d1 * d1 + d2 * d2);
-      stretch_c = st.k * st.limit / (s1 * s2 * (s1 + s2));
-      stretch_i = st.k * d2 / s2 - stretch_c * s2 * s2;
-    } else {
-      psi += st.k * d1 * d1;
-      stretch_c = d1 > T(0) ? g1 / (T(2) * h) : T(0);  // d1 > 0 here implies s1 > s2, h > 0
-      stretch_i = -stretch_c * s2 * s2;
-    }
-  }
-  if (S) {
-    const T beta = T(2) * q / tr;
-    const T alpha = T(0.5) * (L - beta * tr);
-    const T k = (T(0.5) * mu * alpha + T(0.25) * lambda * L) / det;
-    const T d = T(0.5) * mu * beta;
-    // dpsi/dC = k adj(C) + d I (+ stretch_i I + stretch_c C beyond the limit)
-    T s11 = k * c22 + d, s12 = -k * c12, s22 = k * c11 + d;
-    if (beyond) {
-      s11 += stretch_i + stretch_c * c11;
-      s12 += stretch_c * c12;
-      s22 += stretch_i + stretch_c * c22;
-    }
-    // dpsi/dM = Bp S_C Bp^T
-    const T r00 = b00 * s11 + b01 * s12, r01 = b00 * s12 + b01 * s22;
-    const T r10 = b10 * s11 + b11 * s12, r11 = b10 * s12 + b11 * s22;
-    S[0] = r00 * b00 + r01 * b01;
-    S[1] = r00 * b10 + r01 * b11;
-    S[2] = r10 * b10 + r11 * b11;
-  }
-  return psi;
-}
-
-/// Log singular values (log s1, log s2) of the elastic block (for statistics).
-template <class T>
-inline void layer_log_s(const T* Bp, T m11, T m12, T m22, T& l1, T& l2) {
-  const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
-  const T mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
-  const T mb1x = m11 * b01 + m12 * b11, mb1y = m12 * b01 + m22 * b11;
-  const T c11 = b00 * mb0x + b10 * mb0y;
-  const T c12 = b00 * mb1x + b10 * mb1y;
-  const T c22 = b01 * mb1x + b11 * mb1y;
-  const T tr = c11 + c22;
-  const T hd = T(0.5) * (c11 - c22);
-  const T x = T(2) * std::sqrt(hd * hd + c12 * c12) / tr;
-  const T L = std::log(c11 * c22 - c12 * c12);
-  const T D = T(2) * x * atanh_over_x(x);
-  l1 = T(0.25) * (L + D);
-  l2 = T(0.25) * (L - D);
-}
-
-template <class T>
-inline void mul2(const T* A, const T* B, T* out) {  // row-major 2x2 product
-  out[0] = A[0] * B[0] + A[1] * B[2];
-  out[1] = A[0] * B[1] + A[1] * B[3];
-  out[2] = A[2] * B[0] + A[3] * B[2];
-  out[3] = A[2] * B[1] + A[3] * B[3];
-}
-
 }  // namespace
+
+using kl::gather_kinematics;
+using kl::kPointGrain;
+using kl::layer_log_s;
+using kl::layer_psi;
+using kl::mul2;
+using kl::PointKinematics;
 
 template <class T>
 KirchhoffLoveShellT<T>::KirchhoffLoveShellT(std::vector<BasisPoint> points,
@@ -441,78 +291,6 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
   out.membrane = T(em);
   out.bending = T(et - em);
   return out;
-}
-
-template <class T>
-T KirchhoffLoveShellT<T>::project_plasticity(const Vec3T* x, bool serial) {
-  if (!has_plasticity()) return T(0);
-  const double work =
-      ordered_reduce_chunks(area_.size(), kPointGrain, serial, 0.0, [&](std::size_t b, std::size_t e) {
-        double w = 0.0;
-        for (std::size_t q = b; q < e; ++q) {
-          PointKinematics<T> k;
-          gather_kinematics(begin_, ctrl_, coef_, q, x, k);
-          for (int l = 0; l < num_layers_; ++l) {
-            const std::size_t ql = q * num_layers_ + l;
-            const T xi3 = layer_xi3_[l];
-            const Vec3T g1 = k.a1 + xi3 * k.v1, g2 = k.a2 + xi3 * k.v2;
-            Mat2T M;
-            M << g1.dot(g1), g1.dot(g2), g1.dot(g2), g2.dot(g2);
-            T* Fi = &fp_inv_[4 * ql];
-            T Bp[4];
-            mul2(&B_[4 * ql], Fi, Bp);
-            Mat2T Bm;
-            Bm << Bp[0], Bp[1], Bp[2], Bp[3];
-            const Mat2T Ce = Bm.transpose() * M * Bm;
-            Mat2T F;
-            F << Fi[0], Fi[1], Fi[2], Fi[3];
-            const T released = denting_project_layer(mu_, lambda_, yield_, Ce, F);
-            // Below yield F is untouched, so this copy is bitwise neutral.
-            Fi[0] = F(0, 0);
-            Fi[1] = F(0, 1);
-            Fi[2] = F(1, 0);
-            Fi[3] = F(1, 1);
-            w += double(area_[q] * layer_w_[l]) * double(released);
-          }
-        }
-        return w;
-      });
-  return T(work);
-}
-
-template <class T>
-T KirchhoffLoveShellT<T>::max_strain(const Vec3T* x, bool serial) const {
-  const std::size_t nq = area_.size();
-  if (nq == 0) return T(0);
-  const std::size_t chunks = (nq + kPointGrain - 1) / kPointGrain;
-  std::vector<T> part(chunks, T(0));
-  const bool plastic = !fp_inv_.empty();
-  parallel_for(
-      nq, kPointGrain,
-      [&](std::size_t b, std::size_t e) {
-        T m = 0;
-        for (std::size_t q = b; q < e; ++q) {
-          PointKinematics<T> k;
-          gather_kinematics(begin_, ctrl_, coef_, q, x, k);
-          for (int l = 0; l < num_layers_; ++l) {
-            const std::size_t ql = q * num_layers_ + l;
-            const T xi3 = layer_xi3_[l];
-            const Vec3T g1 = k.a1 + xi3 * k.v1, g2 = k.a2 + xi3 * k.v2;
-            const T* B = &B_[4 * ql];
-            T Bp[4];
-            if (plastic) {
-              mul2(B, &fp_inv_[4 * ql], Bp);
-              B = Bp;
-            }
-            T l1, l2;
-            layer_log_s(B, g1.dot(g1), g1.dot(g2), g2.dot(g2), l1, l2);
-            m = std::max(m, std::max(std::abs(l1), std::abs(l2)));
-          }
-        }
-        part[b / kPointGrain] = m;
-      },
-      serial);
-  return *std::max_element(part.begin(), part.end());
 }
 
 template <class T>
