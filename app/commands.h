@@ -27,6 +27,7 @@ struct RunArgs : CommonArgs {
   std::string output;  ///< replaces output.directory
   bool resume = false;
   bool preview = false;  ///< render each frame as it is written (also render.preview)
+  bool force = false;    ///< run even when the memory estimate exceeds the available memory
 };
 
 /// `shellmpm render OUTDIR`: preview images of a run's caches.
