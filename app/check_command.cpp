@@ -21,11 +21,12 @@ void print_estimate(const RunMemory& mem, const AvailableMemory& avail) {
   std::printf("particles: about %.0f at start, about %.0f more emitted\n", n.fill_particles,
               n.emitted_particles);
   if (n.shell_points > 0)
-    std::printf("shells: %.0f control points, %.0f triangles, %.0f quadrature points, %.0f "
-                "contact particles\n",
-                n.shell_points, n.shell_triangles, n.quadrature_points, n.contact_sites);
-  std::printf("grid blocks: about %.0f (4x4x4 nodes) around %.0f particle blocks\n",
-              n.grid_blocks, n.particle_blocks);
+    std::printf(
+        "shells: %.0f control points, %.0f triangles, %.0f quadrature points, %.0f "
+        "contact particles\n",
+        n.shell_points, n.shell_triangles, n.quadrature_points, n.contact_sites);
+  std::printf("grid blocks: about %.0f (4x4x4 nodes) around %.0f particle blocks\n", n.grid_blocks,
+              n.particle_blocks);
   std::string parts;
   for (const MemoryPart& p : mem.solver.parts)
     if (p.bytes >= 0.01 * mem.peak)
@@ -41,10 +42,10 @@ void print_estimate(const RunMemory& mem, const AvailableMemory& avail) {
               parts.empty() ? "nothing else" : parts.c_str());
   const double need = mem.peak - mem.baseline;
   if (avail.known && need > avail.bytes)
-    std::printf("warning: that is %s more than now, and only %s is available (%s): "
-                "`shellmpm run` will refuse it (run --force tries anyway)\n",
-                format_bytes(need).c_str(), format_bytes(avail.bytes).c_str(),
-                avail.source.c_str());
+    std::printf(
+        "warning: that is %s more than now, and only %s is available (%s): "
+        "`shellmpm run` will refuse it (run --force tries anyway)\n",
+        format_bytes(need).c_str(), format_bytes(avail.bytes).c_str(), avail.source.c_str());
 }
 
 }  // namespace
@@ -63,10 +64,11 @@ int check_command(const CommonArgs& a) {
   print_estimate(mem, avail);
   const double need = mem.peak - mem.baseline;
   if (mem.peak > kCheckBuildLimit || (avail.known && need > 0.5 * avail.bytes)) {
-    std::printf("note: check does not build a shot this large (over %s, or over half the "
-                "available memory): its stages and time step are not estimated; `shellmpm "
-                "run` reports them\n",
-                format_bytes(kCheckBuildLimit).c_str());
+    std::printf(
+        "note: check does not build a shot this large (over %s, or over half the "
+        "available memory): its stages and time step are not estimated; `shellmpm "
+        "run` reports them\n",
+        format_bytes(kCheckBuildLimit).c_str());
     return kExitOk;
   }
 
@@ -77,11 +79,11 @@ int check_command(const CommonArgs& a) {
   for (std::size_t si = 0; si < solver.shells().size(); ++si) {
     const auto& sh = solver.shells()[si];
     const ShellMaterialDesc& m = scene.shell_materials[sh->desc().material];
-    std::printf("shell %s: %zu control points, %zu output vertices, %d x %d quadrature points per "
-                "triangle, stable step %.3g s%s\n",
-                sh->name().c_str(), sh->size(), sh->limit_mesh().num_vertices(),
-                m.quadrature_inplane, m.quadrature_thickness, sh->stable_dt(s.cfl),
-                m.yield_stress > 0 ? ", denting" : "");
+    std::printf(
+        "shell %s: %zu control points, %zu output vertices, %d x %d quadrature points per "
+        "triangle, stable step %.3g s%s\n",
+        sh->name().c_str(), sh->size(), sh->limit_mesh().num_vertices(), m.quadrature_inplane,
+        m.quadrature_thickness, sh->stable_dt(s.cfl), m.yield_stress > 0 ? ", denting" : "");
     if (const ShellContact* c = solver.contact(si)) {
       // Mean rest edge of the control mesh against dx (METHOD.md: keep them close; a grid
       // much coarser than the mesh leaves gaps between shells in contact, a much finer
@@ -91,15 +93,17 @@ int check_command(const CommonArgs& a) {
       for (const auto& t : sh->triangles())
         for (int e = 0; e < 3; ++e, ++n) sum += (sh->rest[t[e]] - sh->rest[t[(e + 1) % 3]]).norm();
       const double h = n ? sum / static_cast<double>(n) : 0;
-      std::printf("  contact: %zu contact particles (%d per triangle), k_c %g Pa, gamma %g Pa, "
-                  "friction %g; mean edge %.3g m = %.2f dx\n",
-                  c->num_sites(), m.contact_samples, c->params().kc, c->params().gamma,
-                  c->params().friction, h, h / s.dx);
+      std::printf(
+          "  contact: %zu contact particles (%d per triangle), k_c %g Pa, gamma %g Pa, "
+          "friction %g; mean edge %.3g m = %.2f dx\n",
+          c->num_sites(), m.contact_samples, c->params().kc, c->params().gamma,
+          c->params().friction, h, h / s.dx);
       if (h > 2.0 * s.dx || h < 0.5 * s.dx)
-        std::printf("warning: shell %s: its mesh spacing (%.3g m) is %s than the grid spacing dx = "
-                    "%g m; keep them within a factor 2 (%s)\n",
-                    sh->name().c_str(), h, h > s.dx ? "much coarser" : "much finer", s.dx,
-                    h > s.dx ? "refine the mesh or raise dx" : "coarsen the mesh or lower dx");
+        std::printf(
+            "warning: shell %s: its mesh spacing (%.3g m) is %s than the grid spacing dx = "
+            "%g m; keep them within a factor 2 (%s)\n",
+            sh->name().c_str(), h, h > s.dx ? "much coarser" : "much finer", s.dx,
+            h > s.dx ? "refine the mesh or raise dx" : "coarsen the mesh or lower dx");
     } else {
       std::printf("  contact: off (the shell moves on its own, without the grid)\n");
     }
@@ -126,8 +130,10 @@ int check_command(const CommonArgs& a) {
     std::printf("%s%s (%.2g s)\n",
                 i == 0 ? "time step limited by: " : "  then: ", limits[i].detail.c_str(),
                 limits[i].dt);
-  std::printf("estimated time per frame at the peak: %.2f s on %d threads (at %.1fM particle-steps/s/thread)\n",
-              sec, threads, kParticleStepsPerSecondPerThread / 1e6);
+  std::printf(
+      "estimated time per frame at the peak: %.2f s on %d threads (at %.1fM "
+      "particle-steps/s/thread)\n",
+      sec, threads, kParticleStepsPerSecondPerThread / 1e6);
   // A step below dt_min stops the run; say so now, with the cause (a warning: exit 0).
   if (dt < s.dt_min)
     std::printf(

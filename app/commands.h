@@ -33,11 +33,11 @@ struct RunArgs : CommonArgs {
 /// `shellmpm render OUTDIR`: preview images of a run's caches.
 struct RenderArgs {
   std::string outdir;
-  std::string frames;    ///< "A-B" or "A"; default: the frames the run wrote
-  std::string camera;    ///< replaces render.camera
-  std::string size;      ///< "WxH"; replaces render.size
-  std::string renderer;  ///< raster | raytrace; replaces render.renderer
-  std::string scene;     ///< a scene file to use instead of OUTDIR/run.json
+  std::string frames;                  ///< "A-B" or "A"; default: the frames the run wrote
+  std::string camera;                  ///< replaces render.camera
+  std::string size;                    ///< "WxH"; replaces render.size
+  std::string renderer;                ///< raster | raytrace; replaces render.renderer
+  std::string scene;                   ///< a scene file to use instead of OUTDIR/run.json
   std::vector<std::string> overrides;  ///< --set, after the run's own
   int threads = -1;                    ///< -1: from the scene
   Verbosity verbosity = Verbosity::Normal;

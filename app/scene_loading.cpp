@@ -15,7 +15,6 @@
 
 namespace shellmpm {
 
-
 LoadedScene load_scene_for_cli(const CommonArgs& a, const std::string& frames,
                                const std::string& output) {
   LoadedScene ls;
@@ -36,8 +35,7 @@ LoadedScene load_scene_for_cli(const CommonArgs& a, const std::string& frames,
       throw UserError("--frames " + frames, 0, "", "expected A-B or A with frame numbers >= 1");
     const int a0 = std::stoi(m[1]);
     const int b0 = m[2].matched ? std::stoi(m[2]) : a0;
-    if (a0 < 1 || b0 < a0)
-      throw UserError("--frames " + frames, 0, "", "need 1 <= A <= B");
+    if (a0 < 1 || b0 < a0) throw UserError("--frames " + frames, 0, "", "need 1 <= A <= B");
     shot.frame_start = a0;
     shot.frame_end = b0;
   }

@@ -95,11 +95,16 @@ double parse_memory_size(const std::string& text) {
   if (end == text.c_str() || !std::isfinite(v) || v < 0) return -1;
   const std::string suffix = end;
   double scale = 1;
-  if (suffix == "K" || suffix == "k") scale = 1024.0;
-  else if (suffix == "M") scale = 1024.0 * 1024;
-  else if (suffix == "G") scale = 1024.0 * 1024 * 1024;
-  else if (suffix == "T") scale = 1024.0 * 1024 * 1024 * 1024;
-  else if (!suffix.empty()) return -1;
+  if (suffix == "K" || suffix == "k")
+    scale = 1024.0;
+  else if (suffix == "M")
+    scale = 1024.0 * 1024;
+  else if (suffix == "G")
+    scale = 1024.0 * 1024 * 1024;
+  else if (suffix == "T")
+    scale = 1024.0 * 1024 * 1024 * 1024;
+  else if (!suffix.empty())
+    return -1;
   return v * scale;
 }
 
@@ -144,8 +149,11 @@ std::string format_bytes(double bytes) {
     ++u;
   }
   char buf[32];
-  std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : bytes < 10 ? "%.2f %s" : "%.1f %s", bytes,
-                units[u]);
+  std::snprintf(buf, sizeof buf,
+                u == 0       ? "%.0f %s"
+                : bytes < 10 ? "%.2f %s"
+                             : "%.1f %s",
+                bytes, units[u]);
   return buf;
 }
 

@@ -12,10 +12,11 @@ namespace shellmpm {
 
 struct RunMemory {
   SolverMemory solver;
-  double baseline = 0;    ///< the process before the solver is built [bytes]
-  double writers = 0;     ///< the largest writer's transient [bytes]
-  std::string writer;     ///< which writer that is ("density VDB", "checkpoint", ...)
-  /// The estimated peak resident size of the run [bytes]: baseline + the larger of the
+  double baseline = 0;  ///< the process before the solver is built [bytes]
+  double writers = 0;   ///< the largest writer's transient [bytes]
+  std::string writer;   ///< which writer that is ("density VDB", "checkpoint", ...)
+  /// The estimated peak resident size of the run [bytes]: baseline + what a run touches
+  /// of its libraries beyond check (8 MiB) + the larger of the
   /// solver's construction and what it holds plus the larger of a step's scratch and the
   /// writers' transient (the writers run between steps).
   double peak = 0;

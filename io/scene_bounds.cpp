@@ -55,8 +55,8 @@ void check_sources(const Scene& scene) {
     }
     if (found) {
       std::ostringstream os;
-      os << "source reaches outside shot.domain (less one cell, dx = " << s.dx
-         << "): e.g. " << point_text(bad) << "; enlarge the domain or move the source";
+      os << "source reaches outside shot.domain (less one cell, dx = " << s.dx << "): e.g. "
+         << point_text(bad) << "; enlarge the domain or move the source";
       throw detail::user_error_at(where, os.str());
     }
   }

@@ -177,11 +177,7 @@ std::vector<KeySpec> build_schema() {
           .choices({"fixed_corotated", "neo_hookean"})
           .only_for({"elastic"}),
       Spec("materials[].youngs_modulus", T::Number).def("1e5").unit("Pa").ge(1).le(1e12),
-      Spec("materials[].poisson_ratio", T::Number)
-          .def("0.3")
-          .ge(0)
-          .lt(0.5)
-          .rule(kStiffestModulus),
+      Spec("materials[].poisson_ratio", T::Number).def("0.3").ge(0).lt(0.5).rule(kStiffestModulus),
       Spec("materials[].density", T::Number).def("1000").unit("kg/m^3").ge(0.1).le(1e5),
       Spec("materials[].friction_angle", T::Number)
           .def("30")
@@ -206,7 +202,9 @@ std::vector<KeySpec> build_schema() {
           .nonempty()
           .rule("unique"),
       Spec("sources[].material", T::String).required().rule("a name in materials"),
-      Spec("sources[].shape", T::Shape).required().rule("not a plane; inside shot.domain, one cell in"),
+      Spec("sources[].shape", T::Shape)
+          .required()
+          .rule("not a plane; inside shot.domain, one cell in"),
       Spec("sources[].particles_per_cell", T::Number).def("8").ge(1).le(64),
       Spec("sources[].velocity", T::Vec3).def("[0, 0, 0]").unit("m/s").ge(-1e5).le(1e5),
       Spec("sources[].seed", T::Int).def("1").ge(0).le(4294967295.0),
@@ -368,10 +366,7 @@ std::vector<KeySpec> build_schema() {
           .nonempty()
           .rule("`auto` or a name in cameras"),
       Spec("render.cameras", T::List).def("[]"),
-      Spec("render.cameras[].name", T::String)
-          .required()
-          .nonempty()
-          .rule("unique; not `auto`"),
+      Spec("render.cameras[].name", T::String).required().nonempty().rule("unique; not `auto`"),
       Spec("render.cameras[].position", T::Vec3).required().unit("m"),
       Spec("render.cameras[].target", T::Vec3).required().unit("m").rule("not at position"),
       Spec("render.cameras[].up", T::Vec3)
@@ -1321,8 +1316,8 @@ void apply_override(DocNode& root, const std::string& ov) {
                                                                       : Expect::Leaf;
   }
   const bool item = !segs.empty() && segs.back().is_index;  // a whole list entry: a mapping
-  *cur = convert(load_override_value(text, where, path, item ? nullptr : leaf), where, false, 0,
-                 path);
+  *cur =
+      convert(load_override_value(text, where, path, item ? nullptr : leaf), where, false, 0, path);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -1359,8 +1354,7 @@ void require_output_file(const std::string& path, bool is_pattern, const Origin&
                          const std::string& key) {
   if (!path.empty() && path.front() == '/') {
     fail(o, key,
-         "must be relative to output.directory (files are written inside it), got '" + path +
-             "'");
+         "must be relative to output.directory (files are written inside it), got '" + path + "'");
   }
   const std::size_t slash = path.rfind('/');
   const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
@@ -1368,9 +1362,9 @@ void require_output_file(const std::string& path, bool is_pattern, const Origin&
     fail(o, key, "must end in a file name, got '" + path + "'");
   }
   if (is_pattern && slash != std::string::npos && path.find('#') < slash) {
-    fail(o, key,
-         "the '#' run (frame number) must be in the file name, not in a folder: got '" + path +
-             "'");
+    fail(
+        o, key,
+        "the '#' run (frame number) must be in the file name, not in a folder: got '" + path + "'");
   }
 }
 
@@ -1430,7 +1424,8 @@ void require_in_position_range(const Vec3d& p, const ShotSettings& shot, const O
     fail(o, key,
          what + " reaches " + kAxis[a] + " = " + fmt_num(p[a]) +
              " m, more than 2^17 = 131072 cells of dx = " + fmt_num(shot.dx) + " m (" +
-             fmt_num(range) + " m) from the origin, where a float position no longer resolves "
+             fmt_num(range) +
+             " m) from the origin, where a float position no longer resolves "
              "1/64 of a cell");
   }
 }
@@ -1586,7 +1581,8 @@ void read_shot(const DocNode& node, ShotSettings& shot) {
         fail(d.origin_of(corner), d.path_of(corner) + "[" + std::to_string(a) + "]",
              std::string("coordinate ") + kAxis[a] + " = " + fmt_num(c[a]) +
                  " m is more than 2^17 = 131072 cells of dx = " + fmt_num(shot.dx) + " m (" +
-                 fmt_num(range) + " m) from the origin, where a float position can no longer "
+                 fmt_num(range) +
+                 " m) from the origin, where a float position can no longer "
                  "resolve 1/64 of a cell; move the shot towards the origin or use a larger dx");
       }
     }
@@ -1660,13 +1656,13 @@ MaterialDesc read_material(const DocNode& node, const std::string& path) {
         m.kind == MaterialKind::Snow ? std::exp(m.hardening * m.critical_compression) : 1.0;
     const double modulus = m.youngs_modulus * ratio * harden;
     if (!(modulus <= 1e14)) {
-      const std::string at = harden > ratio ? "hardening" : ratio > 100 ? "poisson_ratio"
-                                                                        : "youngs_modulus";
+      const std::string at = harden > ratio ? "hardening"
+                             : ratio > 100  ? "poisson_ratio"
+                                            : "youngs_modulus";
       fail(r.origin_of(at), r.path_of(at),
            "the material's stiffest modulus E (1 - nu) / ((1 + nu) (1 - 2 nu))" +
-               std::string(m.kind == MaterialKind::Snow
-                               ? " exp(hardening critical_compression)"
-                               : "") +
+               std::string(m.kind == MaterialKind::Snow ? " exp(hardening critical_compression)"
+                                                        : "") +
                " is " + fmt3(modulus) + " Pa (E " + fmt_num(m.youngs_modulus) + ", nu " +
                fmt_num(nu) +
                (m.kind == MaterialKind::Snow ? ", hardening factor " + fmt_num(harden) : "") +
@@ -1926,10 +1922,9 @@ ShellDesc read_shell(const DocNode& node, std::size_t i, const Scene& scene,
     // checked once loaded: io/scene_bounds.h); a shell thicker than its radius has
     // inverted layers.
     const double range = kPositionRangeCells * scene.shot.dx;
-    const double extent = sh.kind == ShellDesc::Kind::Sheet
-                              ? std::max(sh.size[0], sh.size[1])
-                              : sh.kind == ShellDesc::Kind::Mesh ? 0.0
-                                                                 : std::max(sh.radius, sh.height);
+    const double extent = sh.kind == ShellDesc::Kind::Sheet  ? std::max(sh.size[0], sh.size[1])
+                          : sh.kind == ShellDesc::Kind::Mesh ? 0.0
+                                                             : std::max(sh.radius, sh.height);
     if (!(sh.scale * extent <= 2.0 * range)) {
       fail(r.origin_of("geometry"), r.path_of("geometry"),
            "the shell is " + fmt_num(sh.scale * extent) + " m across (with scale " +
@@ -2287,8 +2282,7 @@ Scene parse_scene(const std::string& text, const std::string& path,
       throw UserError("--set", 0, in_key ? "" : key,
                       "not valid UTF-8: byte " + locate_utf8_error(ov, bad).byte_hex + " at " +
                           "character " + std::to_string(bad + 1) + " of the override" +
-                          (in_key ? " (in its key)" : "") +
-                          "; scene values are UTF-8 text");
+                          (in_key ? " (in its key)" : "") + "; scene values are UTF-8 text");
     }
   }
   DocNode root = convert(load_yaml(text, path, "", true), path, true, 0, "");

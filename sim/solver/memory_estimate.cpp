@@ -86,9 +86,9 @@ double cross_section(const ShapeDesc& s, const Vec3d& d) {
       const Vec3d e = shape_extent(s);
       const double box = e.prod();
       const double fill = box > 0 ? std::min(1.0, shape_volume(s) / box) : 0;
-      return std::pow(fill, 2.0 / 3.0) * (std::abs(d.x()) * e.y() * e.z() +
-                                          std::abs(d.y()) * e.x() * e.z() +
-                                          std::abs(d.z()) * e.x() * e.y());
+      return std::pow(fill, 2.0 / 3.0) *
+             (std::abs(d.x()) * e.y() * e.z() + std::abs(d.y()) * e.x() * e.z() +
+              std::abs(d.z()) * e.x() * e.y());
     }
     case ShapeDesc::Kind::Plane:
       return 0;
@@ -160,9 +160,9 @@ ShellCounts shell_counts(const ShellDesc& d) {
       double sum = 0, area = 0;
       for (const Eigen::Vector3i& t : m.triangles) {
         sum += std::max(6, faces[t[0]] + faces[t[1]] + faces[t[2]] - 6);
-        area += 0.5 * (m.vertices[t[1]] - m.vertices[t[0]])
-                          .cross(m.vertices[t[2]] - m.vertices[t[0]])
-                          .norm();
+        area +=
+            0.5 *
+            (m.vertices[t[1]] - m.vertices[t[0]]).cross(m.vertices[t[2]] - m.vertices[t[0]]).norm();
       }
       c.support = c.triangles > 0 ? sum / c.triangles : 12;
       c.area = area * s2;
@@ -205,8 +205,7 @@ double grid_bytes(double points, double pblocks, double gblocks) {
 }  // namespace
 
 bool shell_contact_on(const Scene& scene, std::size_t i) {
-  const bool others =
-      !scene.colliders.empty() || !scene.sources.empty() || scene.shells.size() > 1;
+  const bool others = !scene.colliders.empty() || !scene.sources.empty() || scene.shells.size() > 1;
   const ShellDesc::Contact mode = scene.shells[i].contact;
   return mode == ShellDesc::Contact::On || (mode == ShellDesc::Contact::Auto && others);
 }
@@ -230,7 +229,8 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   // Bulk particles and the blocks they occupy (at rest density; emitted material counted
   // as a loose pile, half full).
   bool plastic = false;
-  for (const MaterialDesc& m : scene.materials) plastic = plastic || m.kind != MaterialKind::Elastic;
+  for (const MaterialDesc& m : scene.materials)
+    plastic = plastic || m.kind != MaterialKind::Elastic;
   const double per_particle = 2 * kVec3 + 2 * kMat3 + R + 2 + 4 + (plastic ? R : 0);
   out.bytes_per_particle = per_particle;
   double largest_fill = 0;
@@ -281,7 +281,8 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
     const double cap = grown(S);
     const double points = qp * (7 * kVector + chunk(4 * cap) + 6 * chunk(8 * cap)) + 8 * qp;
     const double rest_mesh = 24 * V + 12 * T + (c.has_uvs ? 16 * V : 0);
-    construction = std::max(construction, shells_persistent + object + basis + kl + points + rest_mesh);
+    construction =
+        std::max(construction, shells_persistent + object + basis + kl + points + rest_mesh);
     shells_persistent += persistent;
     shell_bytes += persistent;
     force_scratch = std::max(force_scratch, 15 * R * qp);  // adjoints per quadrature point
@@ -309,7 +310,8 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   // Per-shell velocity fields (shot.shell_velocities: per_shell) when two bodies share the
   // grid: each grid shell bins its control points into its own grid and keeps 6^3
   // buffers and 4^3 nodes of 14 Reals; the combined grid keeps the bulk moments.
-  const bool fields = fields_wanted && (grid_shells >= 2 || (grid_shells >= 1 && !scene.sources.empty()));
+  const bool fields =
+      fields_wanted && (grid_shells >= 2 || (grid_shells >= 1 && !scene.sources.empty()));
   if (fields) {
     for (double pb : shell_pblocks) {
       const double gb = 2.2 * pb;
@@ -321,14 +323,18 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
 
   // The particles at the peak, and the combined grid.
   const double particles = per_particle * n.peak_particles();
-  const double grid = grid_bytes(n.peak_particles() + grid_points, n.particle_blocks, n.grid_blocks);
+  const double grid =
+      grid_bytes(n.peak_particles() + grid_points, n.particle_blocks, n.grid_blocks);
   // The integrity monitor records a side per particle and limit vertex once shells are on
   // the grid.
   if (grid_shells > 0) integrity_bytes += 3 * n.peak_particles();
 
-  out.parts = {{"particles", particles},  {"grid", grid},
-               {"shells", shell_bytes},   {"contact", contact_bytes},
-               {"per-shell fields", fields_bytes}, {"integrity", integrity_bytes}};
+  out.parts = {{"particles", particles},
+               {"grid", grid},
+               {"shells", shell_bytes},
+               {"contact", contact_bytes},
+               {"per-shell fields", fields_bytes},
+               {"integrity", integrity_bytes}};
   double held = 0;
   for (const MemoryPart& p : out.parts) held += p.bytes;
   // A step: the adjoints of the largest shell's forces; an emitting run also copies one

@@ -22,8 +22,10 @@ const std::string kHead =
 // A shell scene from line 5: material on line 6, shell on lines 8-10.
 std::string shell_scene(const std::string& material_extra, const std::string& shell_extra) {
   return kHead +
-         "shell_materials:\n"                                            // 5
-         "  - {name: cloth" + material_extra + "}\n"                     // 6
+         "shell_materials:\n"  // 5
+         "  - {name: cloth" +
+         material_extra +
+         "}\n"                                                           // 6
          "shells:\n"                                                     // 7
          "  - material: cloth\n"                                         // 8
          "    geometry: {type: sphere, radius: 0.3, subdivisions: 1}\n"  // 9
@@ -85,16 +87,18 @@ TEST_CASE("scene values: what overflows float is refused at its key", "[scene][v
   }
   SECTION("the stiffest modulus of a bulk material") {
     // E (1 - nu) / ((1 + nu) (1 - 2 nu)): 17 E at nu = 0.49, 167 E at 0.499.
-    const std::string mat = kHead + "materials:\n  - {name: m, type: elastic, youngs_modulus: "
-                                    "1e12, poisson_ratio: 0.49}\n";
+    const std::string mat = kHead +
+                            "materials:\n  - {name: m, type: elastic, youngs_modulus: "
+                            "1e12, poisson_ratio: 0.49}\n";
     REQUIRE_NOTHROW(parse_scene(mat, "scenes/v.yaml"));
     expect(mat, 0, "materials[0].poisson_ratio", {"is 1.67e14 Pa", "at most 1e14"},
            {"materials[0].poisson_ratio=0.499"});
     // nu close to 1/2 makes even a soft material that stiff.
     expect(mat, 0, "materials[0].poisson_ratio", {"at most 1e14"},
            {"materials[0].youngs_modulus=1e6", "materials[0].poisson_ratio=0.499999999"});
-    const std::string snow = kHead + "materials:\n  - {name: s, type: snow, hardening: 100, "
-                                     "critical_compression: 0.5}\n";
+    const std::string snow = kHead +
+                             "materials:\n  - {name: s, type: snow, hardening: 100, "
+                             "critical_compression: 0.5}\n";
     expect(snow, 6, "materials[0].hardening", {"hardening factor", "at most 1e14"});
   }
 }
@@ -104,11 +108,13 @@ TEST_CASE("scene values: the domain and colliders stay within the position range
   // 2^17 cells of 0.1 m = 13107.2 m.
   expect(kHead, 0, "shot.domain.min[0]", {"x = -20000", "131072 cells"},
          {"shot.domain.min=[-2e4,-1,-1]"});
-  const std::string coll = kHead + "colliders:\n  - {shape: {type: sphere, center: [0, 0, 0], "
-                                   "radius: 1e38}}\n";
+  const std::string coll = kHead +
+                           "colliders:\n  - {shape: {type: sphere, center: [0, 0, 0], "
+                           "radius: 1e38}}\n";
   expect(coll, 6, "colliders[0].shape", {"the collider reaches", "-1e38"});
-  const std::string plane = kHead + "colliders:\n  - {shape: {type: plane, point: [0, 1e6, 0], "
-                                    "normal: [0, 1, 0]}}\n";
+  const std::string plane = kHead +
+                            "colliders:\n  - {shape: {type: plane, point: [0, 1e6, 0], "
+                            "normal: [0, 1, 0]}}\n";
   expect(plane, 6, "colliders[0].shape.point", {"the plane's point"});
   const std::string keys = kHead +
                            "colliders:\n"
@@ -131,13 +137,14 @@ TEST_CASE("scene values: timing that could never advance is refused", "[scene][v
 }
 
 TEST_CASE("scene values: output names are files inside output.directory", "[scene][values]") {
-  REQUIRE_NOTHROW(parse_scene(kHead, "v.yaml", {"output.stats=sub/dir/stats.json",
-                                               "output.density_pattern=vdb/density.####.vdb"}));
+  REQUIRE_NOTHROW(parse_scene(
+      kHead, "v.yaml",
+      {"output.stats=sub/dir/stats.json", "output.density_pattern=vdb/density.####.vdb"}));
   expect(kHead, 0, "output.stats", {"relative to output.directory"},
          {"output.stats=/tmp/stats.json"});
   expect(kHead, 0, "output.stats", {"must end in a file name"}, {"output.stats=sub/"});
-  expect(kHead + "output:\n  density_pattern: \"f####/density.vdb\"\n", 6,
-         "output.density_pattern", {"must be in the file name, not in a folder"});
+  expect(kHead + "output:\n  density_pattern: \"f####/density.vdb\"\n", 6, "output.density_pattern",
+         {"must be in the file name, not in a folder"});
   expect(kHead, 0, "output.voxel_size", {"between dx/8 and 16 dx", "0.0125 .. 1.6"},
          {"output.voxel_size=1e-300"});
 }
@@ -166,8 +173,7 @@ TEST_CASE("scene values: --set values that YAML reads as syntax say how to quote
   SECTION("'{' starts a flow mapping") {
     const std::string ov = "output.shell_pattern={name}.####.ply";
     expect(kHead, 0, "output.shell_pattern",
-           {"'{' starts a YAML flow mapping",
-            "--set 'output.shell_pattern=\"{name}.####.ply\"'"},
+           {"'{' starts a YAML flow mapping", "--set 'output.shell_pattern=\"{name}.####.ply\"'"},
            {ov});
     // The suggested form reads.
     const Scene s = parse_scene(kHead, "v.yaml", {"output.shell_pattern=\"{name}.####.ply\""});
@@ -180,8 +186,7 @@ TEST_CASE("scene values: --set values that YAML reads as syntax say how to quote
            {"output.stats=stats #1.json"});
   }
   SECTION("'*' is an alias; a quote in the value is escaped in the suggestion") {
-    expect(kHead, 0, "output.directory", {"'*' starts a YAML alias"},
-           {"output.directory=*shots"});
+    expect(kHead, 0, "output.directory", {"'*' starts a YAML alias"}, {"output.directory=*shots"});
     expect(kHead, 0, "output.directory", {"--set 'output.directory=\"{a\\\"b}\"'"},
            {"output.directory={a\"b}"});
   }

@@ -36,15 +36,29 @@ void* aligned(std::size_t n, std::align_val_t a) {
 }  // namespace
 
 namespace shellmpm_test {
-std::size_t heap_current() { return g_current.load(); }
-std::size_t heap_peak() { return g_peak.load(); }
-void reset_heap_peak() { g_peak.store(g_current.load()); }
+std::size_t heap_current() {
+  return g_current.load();
+}
+std::size_t heap_peak() {
+  return g_peak.load();
+}
+void reset_heap_peak() {
+  g_peak.store(g_current.load());
+}
 }  // namespace shellmpm_test
 
-void* operator new(std::size_t n) { return counted(std::malloc(n ? n : 1)); }
-void* operator new[](std::size_t n) { return counted(std::malloc(n ? n : 1)); }
-void* operator new(std::size_t n, std::align_val_t a) { return aligned(n, a); }
-void* operator new[](std::size_t n, std::align_val_t a) { return aligned(n, a); }
+void* operator new(std::size_t n) {
+  return counted(std::malloc(n ? n : 1));
+}
+void* operator new[](std::size_t n) {
+  return counted(std::malloc(n ? n : 1));
+}
+void* operator new(std::size_t n, std::align_val_t a) {
+  return aligned(n, a);
+}
+void* operator new[](std::size_t n, std::align_val_t a) {
+  return aligned(n, a);
+}
 void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
   void* p = std::malloc(n ? n : 1);
   return p ? counted(p) : nullptr;
@@ -53,11 +67,27 @@ void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
   void* p = std::malloc(n ? n : 1);
   return p ? counted(p) : nullptr;
 }
-void operator delete(void* p) noexcept { release(p); }
-void operator delete[](void* p) noexcept { release(p); }
-void operator delete(void* p, std::size_t) noexcept { release(p); }
-void operator delete[](void* p, std::size_t) noexcept { release(p); }
-void operator delete(void* p, std::align_val_t) noexcept { release(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { release(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { release(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { release(p); }
+void operator delete(void* p) noexcept {
+  release(p);
+}
+void operator delete[](void* p) noexcept {
+  release(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  release(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+  release(p);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+  release(p);
+}
+void operator delete[](void* p, std::align_val_t) noexcept {
+  release(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  release(p);
+}
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept {
+  release(p);
+}

@@ -56,7 +56,8 @@ double part(const SolverMemory& m, const std::string& what) {
 
 }  // namespace
 
-TEST_CASE("memory estimate: particles of every source shape, filled and emitted", "[memory_estimate]") {
+TEST_CASE("memory estimate: particles of every source shape, filled and emitted",
+          "[memory_estimate]") {
   const Scene s = load(kHead +
                        "materials:\n"
                        "  - {name: jelly, type: elastic}\n"
@@ -68,7 +69,8 @@ TEST_CASE("memory estimate: particles of every source shape, filled and emitted"
                        "  - {material: jelly, particles_per_cell: 16, shape: {type: cylinder, "
                        "center: [-0.5, 0.8, 0.5], axis: [1, 2, 0], radius: 0.1, height: 0.5}}\n"
                        "  - {material: jelly, shape: {type: mesh, path: " +
-                       kAssets + "torus.obj, translate: [0, 0.9, -0.5]}}\n"
+                       kAssets +
+                       "torus.obj, translate: [0, 0.9, -0.5]}}\n"
                        "  - {material: jelly, velocity: [0, -1.5, 0.5], emit: {frames: [1, 48]}, "
                        "shape: {type: box, min: [-0.1, 1.1, -0.1], max: [0.1, 1.2, 0.2]}}\n"
                        "  - {material: jelly, velocity: [1, -1, 0], emit: {frames: [2, 40]}, "
@@ -138,14 +140,13 @@ TEST_CASE("memory estimate: shells, contact, fields and integrity against their 
   const Case cases[] = {
       {"a sheet without contact", kHead + sheet + "}\n"},
       {"a sphere shell on the grid, with denting",
-       kHead +
-           "shell_materials:\n"
-           "  - {name: tin, youngs_modulus: 1e8, yield_stress: 1e6, quadrature_inplane: 6}\n"
-           "shells:\n"
-           "  - {name: ball, material: tin, geometry: {type: sphere, radius: 0.3, "
-           "subdivisions: 4}, translate: [0, 0.5, 0]}\n"
-           "colliders:\n"
-           "  - {shape: {type: plane, point: [0, -0.1, 0], normal: [0, 1, 0]}}\n"},
+       kHead + "shell_materials:\n"
+               "  - {name: tin, youngs_modulus: 1e8, yield_stress: 1e6, quadrature_inplane: 6}\n"
+               "shells:\n"
+               "  - {name: ball, material: tin, geometry: {type: sphere, radius: 0.3, "
+               "subdivisions: 4}, translate: [0, 0.5, 0]}\n"
+               "colliders:\n"
+               "  - {shape: {type: plane, point: [0, -0.1, 0], normal: [0, 1, 0]}}\n"},
       {"two sheets and a jelly block (per-shell fields)",
        kHead + sheet +
            "}\n"
@@ -162,8 +163,7 @@ TEST_CASE("memory estimate: shells, contact, fields and integrity against their 
            "  - {name: rubber, contact_samples: 3}\n"
            "shells:\n"
            "  - {name: torus, material: rubber, geometry: {type: mesh, path: " +
-           kAssets +
-           "torus.obj}, translate: [0, 0.6, 0], contact: on, output_refine: 1}\n"},
+           kAssets + "torus.obj}, translate: [0, 0.6, 0], contact: on, output_refine: 1}\n"},
   };
   for (const Case& c : cases) {
     CAPTURE(c.name);
