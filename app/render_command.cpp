@@ -4,6 +4,7 @@
 #include <regex>
 
 #include "app/commands.h"
+#include "io/output_folders.h"
 #include "io/scene_reader.h"
 #include "io/user_error.h"
 #include "render/preview_job.h"
@@ -70,6 +71,7 @@ int render_command(const RenderArgs& a) {
   auto say = [&](const std::string& m) {
     if (!quiet) std::fprintf(stderr, "%s\n", m.c_str());
   };
+  create_output_folders(scene, /*previews=*/true);  // render.pattern may name a sub-folder
   PreviewJobOptions po;
   po.outdir = a.outdir;
   po.first_frame = first;
