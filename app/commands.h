@@ -27,16 +27,17 @@ struct RunArgs : CommonArgs {
   std::string output;  ///< replaces output.directory
   bool resume = false;
   bool preview = false;  ///< render each frame as it is written (also render.preview)
+  bool force = false;    ///< run even when the memory estimate exceeds the available memory
 };
 
 /// `shellmpm render OUTDIR`: preview images of a run's caches.
 struct RenderArgs {
   std::string outdir;
-  std::string frames;    ///< "A-B" or "A"; default: the frames the run wrote
-  std::string camera;    ///< replaces render.camera
-  std::string size;      ///< "WxH"; replaces render.size
-  std::string renderer;  ///< raster | raytrace; replaces render.renderer
-  std::string scene;     ///< a scene file to use instead of OUTDIR/run.json
+  std::string frames;                  ///< "A-B" or "A"; default: the frames the run wrote
+  std::string camera;                  ///< replaces render.camera
+  std::string size;                    ///< "WxH"; replaces render.size
+  std::string renderer;                ///< raster | raytrace; replaces render.renderer
+  std::string scene;                   ///< a scene file to use instead of OUTDIR/run.json
   std::vector<std::string> overrides;  ///< --set, after the run's own
   int threads = -1;                    ///< -1: from the scene
   Verbosity verbosity = Verbosity::Normal;

@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--frames", run.frames, "frame range A-B (or one frame A)");
   run_cmd->add_option("--output,-o", run.output, "output directory (replaces output.directory)");
   run_cmd->add_flag("--resume", run.resume, "continue from the newest checkpoint in the output directory");
+  run_cmd->add_flag("--force", run.force,
+                    "run even when the memory estimate exceeds the available memory");
   run_cmd->add_flag("--preview", run.preview,
                     "render each frame to preview.####.png as it is written (see `render`)");
 

@@ -5,6 +5,7 @@
 
 #include "app/commands.h"
 #include "app/frame_range.h"
+#include "io/output_folders.h"
 #include "io/scene_reader.h"
 #include "io/user_error.h"
 #include "render/preview_job.h"
@@ -67,6 +68,7 @@ int render_command(const RenderArgs& a) {
   auto say = [&](const std::string& m) {
     if (!quiet) std::fprintf(stderr, "%s\n", m.c_str());
   };
+  create_output_folders(scene, /*previews=*/true);  // render.pattern may name a sub-folder
   PreviewJobOptions po;
   po.outdir = a.outdir;
   po.first_frame = first;

@@ -19,6 +19,7 @@ int run_command(const RunArgs& a) {
   if (!a.frames.empty()) parse_frames_flag(a.frames);  // before the scene: numbers of any length
   LoadedScene ls = load_scene_for_cli(a, a.frames, a.output);
   const Scene& scene = ls.scene;
+  prepare_run(ls, a.force, a.preview || scene.render.preview);
   ThreadLimit limit(scene.shot.threads);
   Progress progress(a.verbosity, scene.shot.frame_start, scene.shot.frame_end);
   if (a.verbosity == Verbosity::Verbose)

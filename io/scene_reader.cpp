@@ -22,6 +22,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include "io/utf8.h"
+#include "sim/collider/shape_sdf.h"
 #include "sim/core/check.h"
 
 namespace shellmpm {
@@ -101,11 +103,17 @@ class Spec {
 using T = KeyType;
 
 /// The keys of one keyframe list item under `prefix` ("colliders[].keyframes[]").
+/// Position keys that place simulated things off the grid (keyframes, collider shapes): within
+/// the range where Real resolves 1/64 of a cell (see position_range()).
+/// Output file names (patterns, stats): inside output.directory.
+const char* const kOutputFile = "a relative file name; its folders are created";
+const char* const kInPositionRange = "each coordinate within 2^17 dx of the origin";
+
 std::vector<KeySpec> keyframe_specs(const std::string& prefix) {
   return {
       Spec(prefix + ".time", T::Number).optional("give time or frame").unit("s").ge(0),
       Spec(prefix + ".frame", T::Int).optional("give time or frame").ge(1),
-      Spec(prefix + ".translate", T::Vec3).def("[0, 0, 0]").unit("m"),
+      Spec(prefix + ".translate", T::Vec3).def("[0, 0, 0]").unit("m").rule(kInPositionRange),
       Spec(prefix + ".rotate", T::Vec3).def("[0, 0, 0]").unit("deg"),
   };
 }
@@ -118,6 +126,9 @@ std::vector<KeySpec> build_schema() {
   };
   const std::string kPinSelector = "give exactly one of indices, box, group";
   const std::string kColorRule = "linear RGB, each in [0, 1]";
+  const std::string kStiffestModulus =
+      "P-wave modulus E (1 - nu) / ((1 + nu) (1 - 2 nu)), times the largest snow hardening "
+      "exp(hardening critical_compression), <= 1e14 Pa";
   add({
       // top level
       Spec("version", T::Int).required().ge(1).le(1),
@@ -132,15 +143,27 @@ std::vector<KeySpec> build_schema() {
       Spec("render", T::Map).def("{}"),
       // shot
       Spec("shot.frames", T::FrameRange).def("[1, 48]").ge(1),
-      Spec("shot.fps", T::Number).def("24").unit("1/s").gt(0),
+      Spec("shot.fps", T::Number).def("24").unit("1/s").ge(0.01).le(1e5),
       Spec("shot.cfl", T::Number).def("0.3").gt(0).le(1),
-      Spec("shot.dt_min", T::Number).def("1e-6").unit("s").gt(0),
+      Spec("shot.dt_min", T::Number)
+          .def("1e-6")
+          .unit("s")
+          .ge(1e-9)
+          .rule("1 / (fps dt_min) <= 1e7 (steps a frame may take)"),
       Spec("shot.dt_max", T::Number).def("1e-2").unit("s").gt(0).rule(">= dt_min"),
-      Spec("shot.gravity", T::Vec3).def("[0, -9.81, 0]").unit("m/s^2"),
+      Spec("shot.gravity", T::Vec3).def("[0, -9.81, 0]").unit("m/s^2").ge(-1e4).le(1e4),
       Spec("shot.domain", T::Map).required(),
-      Spec("shot.domain.min", T::Vec3).required().unit("m"),
-      Spec("shot.domain.max", T::Vec3).required().unit("m").rule("> min on every axis"),
-      Spec("shot.dx", T::Number).required().unit("m").gt(0).rule("at most 2^20 cells per axis"),
+      Spec("shot.domain.min", T::Vec3).required().unit("m").rule(kInPositionRange),
+      Spec("shot.domain.max", T::Vec3)
+          .required()
+          .unit("m")
+          .rule(std::string("> min on every axis; ") + kInPositionRange),
+      Spec("shot.dx", T::Number)
+          .required()
+          .unit("m")
+          .ge(1e-6)
+          .le(1e3)
+          .rule("at most 2^20 cells per axis"),
       Spec("shot.threads", T::Int).def("0").ge(0),
       Spec("shot.transfer", T::Enum).def("apic").choices({"apic", "mls"}),
       Spec("shot.shell_velocities", T::Enum).def("per_shell").choices({"per_shell", "shared"}),
@@ -153,23 +176,23 @@ std::vector<KeySpec> build_schema() {
           .def("fixed_corotated")
           .choices({"fixed_corotated", "neo_hookean"})
           .only_for({"elastic"}),
-      Spec("materials[].youngs_modulus", T::Number).def("1e5").unit("Pa").gt(0),
-      Spec("materials[].poisson_ratio", T::Number).def("0.3").ge(0).lt(0.5),
-      Spec("materials[].density", T::Number).def("1000").unit("kg/m^3").gt(0),
+      Spec("materials[].youngs_modulus", T::Number).def("1e5").unit("Pa").ge(1).le(1e12),
+      Spec("materials[].poisson_ratio", T::Number).def("0.3").ge(0).lt(0.5).rule(kStiffestModulus),
+      Spec("materials[].density", T::Number).def("1000").unit("kg/m^3").ge(0.1).le(1e5),
       Spec("materials[].friction_angle", T::Number)
           .def("30")
           .unit("deg")
           .ge(0)
           .lt(90)
           .only_for({"sand"}),
-      Spec("materials[].cohesion", T::Number).def("0").ge(0).only_for({"sand"}),
+      Spec("materials[].cohesion", T::Number).def("0").ge(0).le(1).only_for({"sand"}),
       Spec("materials[].critical_compression", T::Number)
           .def("0.025")
           .gt(0)
           .lt(1)
           .only_for({"snow"}),
-      Spec("materials[].critical_stretch", T::Number).def("0.0075").gt(0).only_for({"snow"}),
-      Spec("materials[].hardening", T::Number).def("10").ge(0).only_for({"snow"}),
+      Spec("materials[].critical_stretch", T::Number).def("0.0075").gt(0).le(1).only_for({"snow"}),
+      Spec("materials[].hardening", T::Number).def("10").ge(0).le(100).only_for({"snow"}),
       Spec("materials[].color", T::Vec3)
           .optional("by type: elastic green, sand tan, snow white")
           .rule(kColorRule),
@@ -179,9 +202,11 @@ std::vector<KeySpec> build_schema() {
           .nonempty()
           .rule("unique"),
       Spec("sources[].material", T::String).required().rule("a name in materials"),
-      Spec("sources[].shape", T::Shape).required().rule("not a plane"),
-      Spec("sources[].particles_per_cell", T::Number).def("8").gt(0).le(64),
-      Spec("sources[].velocity", T::Vec3).def("[0, 0, 0]").unit("m/s"),
+      Spec("sources[].shape", T::Shape)
+          .required()
+          .rule("not a plane; inside shot.domain, one cell in"),
+      Spec("sources[].particles_per_cell", T::Number).def("8").ge(1).le(64),
+      Spec("sources[].velocity", T::Vec3).def("[0, 0, 0]").unit("m/s").ge(-1e5).le(1e5),
       Spec("sources[].seed", T::Int).def("1").ge(0).le(4294967295.0),
       Spec("sources[].emit", T::Map)
           .optional("none: fill once at the start")
@@ -192,7 +217,9 @@ std::vector<KeySpec> build_schema() {
           .optional("`collider<i>` (i = list index)")
           .nonempty()
           .rule("unique"),
-      Spec("colliders[].shape", T::Shape).required(),
+      Spec("colliders[].shape", T::Shape)
+          .required()
+          .rule("its bounds (a plane: its point) within 2^17 dx of the origin"),
       Spec("colliders[].boundary", T::Enum).def("separate").choices({"sticky", "slip", "separate"}),
       Spec("colliders[].friction", T::Number).def("0").ge(0),
       Spec("colliders[].keyframes", T::List).def("[]").rule("times strictly increase"),
@@ -201,11 +228,16 @@ std::vector<KeySpec> build_schema() {
   add({
       // shell materials
       Spec("shell_materials[].name", T::String).required().nonempty().rule("unique"),
-      Spec("shell_materials[].youngs_modulus", T::Number).def("1e6").unit("Pa").gt(0),
+      Spec("shell_materials[].youngs_modulus", T::Number).def("1e6").unit("Pa").ge(1).le(1e12),
       Spec("shell_materials[].poisson_ratio", T::Number).def("0.3").ge(0).lt(0.5),
-      Spec("shell_materials[].density", T::Number).def("1000").unit("kg/m^3").gt(0),
-      Spec("shell_materials[].thickness", T::Number).def("0.001").unit("m").gt(0),
-      Spec("shell_materials[].yield_stress", T::Number).def("0").unit("Pa").ge(0),
+      Spec("shell_materials[].density", T::Number).def("1000").unit("kg/m^3").ge(0.1).le(1e5),
+      Spec("shell_materials[].thickness", T::Number)
+          .def("0.001")
+          .unit("m")
+          .ge(1e-7)
+          .le(1)
+          .rule("< the radius of a sphere or cylinder shell"),
+      Spec("shell_materials[].yield_stress", T::Number).def("0").unit("Pa").ge(0).le(1e12),
       Spec("shell_materials[].stretch_limit", T::Number).def("1.5").gt(1).le(1.9),
       Spec("shell_materials[].damping", T::Number).def("0").unit("1/s").ge(0),
       Spec("shell_materials[].stiffness_damping", T::Number).def("0").unit("s").ge(0),
@@ -215,11 +247,13 @@ std::vector<KeySpec> build_schema() {
       Spec("shell_materials[].contact_stiffness", T::Number)
           .optional("`youngs_modulus`")
           .unit("Pa")
-          .gt(0),
+          .gt(0)
+          .le(1e12),
       Spec("shell_materials[].contact_shear", T::Number)
           .optional("`contact_stiffness`")
           .unit("Pa")
-          .gt(0),
+          .gt(0)
+          .le(1e12),
       Spec("shell_materials[].contact_samples", T::Int).def("1").rule("one of: 1, 3, 6, 7"),
       Spec("shell_materials[].front_color", T::Vec3)
           .optional("`render.shell_front`")
@@ -234,14 +268,17 @@ std::vector<KeySpec> build_schema() {
           .rule("unique; letters, digits, `_`, `-` only"),
       Spec("shells[].material", T::String).required().rule("a name in shell_materials"),
       Spec("shells[].geometry", T::Map).required(),
-      Spec("shells[].scale", T::Number).def("1").gt(0),
+      Spec("shells[].scale", T::Number).def("1").ge(1e-6).le(1e6),
       Spec("shells[].rotate", T::Vec3).def("[0, 0, 0]").unit("deg"),
-      Spec("shells[].translate", T::Vec3).def("[0, 0, 0]").unit("m"),
-      Spec("shells[].velocity", T::Vec3).def("[0, 0, 0]").unit("m/s"),
-      Spec("shells[].pressure", T::Number).def("0").unit("Pa"),
+      Spec("shells[].translate", T::Vec3)
+          .def("[0, 0, 0]")
+          .unit("m")
+          .rule("the rest mesh inside shot.domain (one cell in with contact)"),
+      Spec("shells[].velocity", T::Vec3).def("[0, 0, 0]").unit("m/s").ge(-1e5).le(1e5),
+      Spec("shells[].pressure", T::Number).def("0").unit("Pa").ge(-1e12).le(1e12),
       Spec("shells[].point_loads", T::List).def("[]"),
       Spec("shells[].point_loads[].index", T::Int).required().ge(0).rule("< number of vertices"),
-      Spec("shells[].point_loads[].force", T::Vec3).required().unit("N"),
+      Spec("shells[].point_loads[].force", T::Vec3).required().unit("N").ge(-1e12).le(1e12),
       Spec("shells[].pins", T::List).def("[]"),
       Spec("shells[].pins[].indices", T::IntList)
           .optional(kPinSelector)
@@ -304,19 +341,21 @@ std::vector<KeySpec> build_schema() {
       Spec("output.density", T::Bool).def("true"),
       Spec("output.density_pattern", T::String)
           .def("density.####.vdb")
-          .rule("exactly one run of `#`"),
+          .rule(std::string("exactly one run of `#`; ") + kOutputFile),
       Spec("output.velocity", T::Bool).def("false"),
       Spec("output.half_float", T::Bool).def("false"),
-      Spec("output.voxel_size", T::Number).def("0").unit("m").ge(0),
+      Spec("output.voxel_size", T::Number).def("0").unit("m").ge(0).rule("0 or in [dx/8, 16 dx]"),
       Spec("output.particles", T::Bool).def("false"),
       Spec("output.particles_pattern", T::String)
           .def("particles.####.ply")
-          .rule("exactly one run of `#`"),
-      Spec("output.stats", T::String).def("stats.json").nonempty(),
+          .rule(std::string("exactly one run of `#`; ") + kOutputFile),
+      Spec("output.stats", T::String).def("stats.json").nonempty().rule(kOutputFile),
       Spec("output.checkpoint_every", T::Int).def("0").ge(0),
       Spec("output.shell_pattern", T::String)
           .def("\"{name}.####.ply\"")
-          .rule("exactly one run of `#`; contains `{name}` when there are several shells"),
+          .rule(std::string("exactly one run of `#`; contains `{name}` when there are several "
+                            "shells; ") +
+                kOutputFile),
       Spec("output.shell_format", T::Enum).def("ply").choices({"ply", "obj", "glb"}),
       // render (previews; nothing here changes the simulation)
       Spec("render.preview", T::Bool).def("false"),
@@ -327,10 +366,7 @@ std::vector<KeySpec> build_schema() {
           .nonempty()
           .rule("`auto` or a name in cameras"),
       Spec("render.cameras", T::List).def("[]"),
-      Spec("render.cameras[].name", T::String)
-          .required()
-          .nonempty()
-          .rule("unique; not `auto`"),
+      Spec("render.cameras[].name", T::String).required().nonempty().rule("unique; not `auto`"),
       Spec("render.cameras[].position", T::Vec3).required().unit("m"),
       Spec("render.cameras[].target", T::Vec3).required().unit("m").rule("not at position"),
       Spec("render.cameras[].up", T::Vec3)
@@ -360,7 +396,7 @@ std::vector<KeySpec> build_schema() {
       Spec("render.ground_color", T::Vec3).def("[0.5, 0.5, 0.48]").rule(kColorRule),
       Spec("render.pattern", T::String)
           .def("preview.####.png")
-          .rule("exactly one run of `#`; ends in .png"),
+          .rule(std::string("exactly one run of `#`; ends in .png; ") + kOutputFile),
       Spec("render.contact_sheet", T::Bool).def("true"),
       Spec("render.movie", T::Bool).def("true"),
       // shapes (the value of sources[].shape and colliders[].shape)
@@ -378,7 +414,7 @@ std::vector<KeySpec> build_schema() {
           .nonempty()
           .only_for({"mesh"})
           .rule("readable file; relative to the scene file"),
-      Spec("shape.scale", T::Number).def("1").gt(0).only_for({"mesh"}),
+      Spec("shape.scale", T::Number).def("1").ge(1e-6).le(1e6).only_for({"mesh"}),
       Spec("shape.translate", T::Vec3).def("[0, 0, 0]").unit("m").only_for({"mesh"}),
   });
   return schema;
@@ -455,16 +491,49 @@ std::string fmt_num(double x) {
   return s;
 }
 
+/// Three significant digits ("0.0417", "1.67e14").
+std::string fmt3(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  std::string s = buf;  // "1.67e+14" -> "1.67e14", "1e-07" -> "1e-7"
+  const std::size_t e = s.find('e');
+  if (e != std::string::npos) {
+    std::size_t d = e + 1;
+    if (s[d] == '+') s.erase(d, 1);
+    if (s[d] == '-') ++d;
+    while (d + 1 < s.size() && s[d] == '0') s.erase(d, 1);
+  }
+  return s;
+}
+
+/// fmt_num, but a whole number from 1e6 on as "1e12" when that is shorter (tables).
+std::string fmt_bound(double x) {
+  const std::string whole = fmt_num(x);
+  if (!(std::fabs(x) >= 1e6) || x != std::floor(x)) return whole;
+  char buf[64];
+  for (int prec = 1; prec <= 17; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*e", prec - 1, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  std::string e = buf;  // "1e+12" -> "1e12", "2.5e+06" -> "2.5e6"
+  const std::size_t at = e.find('e');
+  std::string mant = e.substr(0, at), exp = e.substr(at + 1);
+  if (exp[0] == '+') exp.erase(0, 1);
+  while (exp.size() > 1 && exp[0] == '0') exp.erase(0, 1);
+  const std::string shortest = mant + "e" + exp;
+  return shortest.size() < whole.size() ? shortest : whole;
+}
+
 /// "(0, 1]", "> 0", ">= 0", "< 90", "= 1", or "" when unbounded.
 std::string bounds_text(const KeySpec& s) {
   const bool lo = std::isfinite(s.min), hi = std::isfinite(s.max);
-  if (lo && hi && s.min == s.max && !s.min_open && !s.max_open) return "= " + fmt_num(s.min);
+  if (lo && hi && s.min == s.max && !s.min_open && !s.max_open) return "= " + fmt_bound(s.min);
   if (lo && hi) {
-    return std::string(s.min_open ? "(" : "[") + fmt_num(s.min) + ", " + fmt_num(s.max) +
+    return std::string(s.min_open ? "(" : "[") + fmt_bound(s.min) + ", " + fmt_bound(s.max) +
            (s.max_open ? ")" : "]");
   }
-  if (lo) return std::string(s.min_open ? "> " : ">= ") + fmt_num(s.min);
-  if (hi) return std::string(s.max_open ? "< " : "<= ") + fmt_num(s.max);
+  if (lo) return std::string(s.min_open ? "> " : ">= ") + fmt_bound(s.min);
+  if (hi) return std::string(s.max_open ? "< " : "<= ") + fmt_bound(s.max);
   return "";
 }
 
@@ -825,7 +894,11 @@ class MapReader {
     }
     Vec3d x;
     for (int i = 0; i < 3; ++i) {
-      x[i] = to_number(v.items[i], path_of(key) + "[" + std::to_string(i) + "]");
+      const std::string item_key = path_of(key) + "[" + std::to_string(i) + "]";
+      x[i] = to_number(v.items[i], item_key);
+      if (!in_bounds(s, x[i])) {
+        fail(v.items[i].origin, item_key, bounds_requirement(s) + ", got " + v.items[i].text);
+      }
     }
     if (s.unit_vector) {
       const double len = x.norm();
@@ -1069,6 +1142,100 @@ std::vector<PathSeg> split_override_path(const std::string& key, const std::stri
   return segs;
 }
 
+/// What in an override's text YAML reads as syntax, for the quoting hint: "'{' starts a
+/// YAML flow mapping"; empty when nothing stands out.
+std::string yaml_special_in(const std::string& text) {
+  const std::size_t first = text.find_first_not_of(" \t");
+  if (first == std::string::npos) return "";
+  const char c = text[first];
+  switch (c) {
+    case '{':
+      return "'{' starts a YAML flow mapping";
+    case '[':
+      return "'[' starts a YAML flow list";
+    case '#':
+      return "'#' at the start starts a YAML comment";
+    case '*':
+      return "'*' starts a YAML alias";
+    case '&':
+      return "'&' starts a YAML anchor";
+    case '!':
+      return "'!' starts a YAML tag";
+    case '|':
+    case '>':
+      return std::string("'") + c + "' starts a YAML block scalar";
+    case '%':
+      return "'%' starts a YAML directive";
+    case '@':
+    case '`':
+      return std::string("'") + c + "' is reserved in YAML";
+    case '"':
+    case '\'':
+      return std::string("the quote ") + c + " at the start is not closed at the end";
+    default:
+      break;
+  }
+  if (text.compare(first, 3, "---") == 0) return "'---' starts a new YAML document";
+  if (text.compare(first, 2, "- ") == 0) return "'- ' starts a YAML list item";
+  for (std::size_t i = first + 1; i < text.size(); ++i) {
+    if (text[i] == '#' && (text[i - 1] == ' ' || text[i - 1] == '\t'))
+      return "' #' starts a YAML comment";
+    if (text[i] == ':' && (i + 1 == text.size() || text[i + 1] == ' '))
+      return "': ' makes it a YAML mapping";
+  }
+  return "";
+}
+
+/// `--set 'KEY="VALUE"'`: the override with VALUE as a YAML double-quoted string, the
+/// whole argument in shell single quotes.
+std::string quoted_override(const std::string& key, const std::string& value) {
+  std::string yaml = "\"";
+  for (char c : value) {
+    if (c == '"' || c == '\\') yaml += '\\';
+    yaml += c;
+  }
+  yaml += "\"";
+  std::string arg = key + "=" + yaml, shell = "'";
+  for (char c : arg) shell += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return "--set " + shell + "'";
+}
+
+/// Parses an override's value. A value YAML does not read as one plain value (a syntax
+/// error, several documents, a comment where a value was meant, a mapping or list for a
+/// string key) is an error that names the character and shows the quoted form.
+YAML::Node load_override_value(const std::string& text, const std::string& where,
+                               const std::string& key, const KeySpec* spec) {
+  std::string problem;
+  YAML::Node value;
+  std::vector<YAML::Node> docs;
+  try {
+    docs = YAML::LoadAll(text);
+  } catch (const YAML::Exception& e) {
+    problem = "YAML syntax error: " + e.msg;
+  }
+  if (problem.empty() && docs.size() > 1)
+    problem = "YAML reads it as " + std::to_string(docs.size()) + " documents";
+  if (problem.empty() && !docs.empty()) value = docs.front();
+  const bool blank = text.find_first_not_of(" \t") == std::string::npos;
+  if (problem.empty() && (docs.empty() || value.IsNull()) && !blank && text != "null" &&
+      text != "~" && text != "Null" && text != "NULL")
+    problem = "YAML reads it as nothing (null)";
+  const bool wants_word = spec && (spec->type == KeyType::String || spec->type == KeyType::Enum);
+  // A plain word cut short by " #" (the rest read as a comment) is not what was meant.
+  if (problem.empty() && value.IsScalar() && value.Tag() == "?" &&
+      (text.find(" #") != std::string::npos || text.find("\t#") != std::string::npos))
+    problem = "YAML reads it as '" + value.Scalar() + "': the rest is a comment";
+  if (problem.empty() && wants_word && (value.IsMap() || value.IsSequence()))
+    problem = std::string("YAML reads it as a ") + (value.IsMap() ? "mapping" : "list");
+  if (problem.empty()) return value;
+  const std::string special = yaml_special_in(text);
+  throw UserError(where, 0, key,
+                  "the value '" + text + "' is not one plain YAML value (" + problem + ")" +
+                      (special.empty() ? "" : ": " + special) +
+                      ". Quote it for YAML, and the whole argument for the shell: " +
+                      quoted_override(key, text));
+}
+
 void apply_override(DocNode& root, const std::string& ov) {
   const std::string where = "--set " + ov;
   const std::size_t eq = ov.find('=');
@@ -1086,6 +1253,7 @@ void apply_override(DocNode& root, const std::string& ov) {
   Expect expect = Expect::Map;
   std::string prefix;  // Map: prefix of its keys; List: prefix of its items' keys
   std::string path;    // instance path so far
+  const KeySpec* leaf = nullptr;  // the schema entry of the last key segment
   for (std::size_t si = 0; si < segs.size(); ++si) {
     const PathSeg& seg = segs[si];
     const bool last = si + 1 == segs.size();
@@ -1141,12 +1309,15 @@ void apply_override(DocNode& root, const std::string& ov) {
     }
     cur = &entry->value;
     path = key_path;
+    leaf = s;
     prefix = child_prefix(*s);
     expect = s->type == KeyType::List                                 ? Expect::List
              : (s->type == KeyType::Map || s->type == KeyType::Shape) ? Expect::Map
                                                                       : Expect::Leaf;
   }
-  *cur = convert(load_yaml(text, where, path, false), where, false, 0, path);
+  const bool item = !segs.empty() && segs.back().is_index;  // a whole list entry: a mapping
+  *cur =
+      convert(load_override_value(text, where, path, item ? nullptr : leaf), where, false, 0, path);
 }
 
 // ------------------------------------------------------------------------------------------
@@ -1173,6 +1344,27 @@ void require_one_hash_run(const std::string& pattern, const Origin& o, const std
     fail(o, key,
          "must contain exactly one run of '#' (replaced by the zero-padded frame number), got '" +
              pattern + "'");
+  }
+}
+
+/// A file name inside output.directory: relative, naming a file (not a folder), with any
+/// sub-folders before it; the `#` run of a pattern (`is_pattern`) in the file name itself,
+/// since the folders are made once before the run (io/output_folders.h).
+void require_output_file(const std::string& path, bool is_pattern, const Origin& o,
+                         const std::string& key) {
+  if (!path.empty() && path.front() == '/') {
+    fail(o, key,
+         "must be relative to output.directory (files are written inside it), got '" + path + "'");
+  }
+  const std::size_t slash = path.rfind('/');
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  if (name.empty() || name == "." || name == "..") {
+    fail(o, key, "must end in a file name, got '" + path + "'");
+  }
+  if (is_pattern && slash != std::string::npos && path.find('#') < slash) {
+    fail(
+        o, key,
+        "the '#' run (frame number) must be in the file name, not in a folder: got '" + path + "'");
   }
 }
 
@@ -1222,10 +1414,27 @@ std::pair<std::string, std::string> read_mesh_path(MapReader& r, const std::stri
   return {p.string(), where_text(o, r.path_of(key))};
 }
 
+/// Fails at `key` when a coordinate of `p` lies beyond the position range
+/// (kPositionRangeCells cells of the origin); `what` names p ("the translation").
+void require_in_position_range(const Vec3d& p, const ShotSettings& shot, const Origin& o,
+                               const std::string& key, const std::string& what) {
+  const double range = kPositionRangeCells * shot.dx;
+  for (int a = 0; a < 3; ++a) {
+    if (std::fabs(p[a]) <= range) continue;
+    fail(o, key,
+         what + " reaches " + kAxis[a] + " = " + fmt_num(p[a]) +
+             " m, more than 2^17 = 131072 cells of dx = " + fmt_num(shot.dx) + " m (" +
+             fmt_num(range) +
+             " m) from the origin, where a float position no longer resolves "
+             "1/64 of a cell");
+  }
+}
+
 /// Reads the keyframe list at `key` (items with the schema keys under `item_prefix`); frame N
 /// is at time (N - 1) / fps. Times must strictly increase.
 std::vector<Keyframe> read_keyframes(MapReader& r, const std::string& key,
-                                     const std::string& item_prefix, double fps) {
+                                     const std::string& item_prefix, const ShotSettings& shot) {
+  const double fps = shot.fps;
   std::vector<Keyframe> out;
   const DocNode& keys = *r.block(key);
   for (std::size_t k = 0; k < keys.items.size(); ++k) {
@@ -1246,6 +1455,8 @@ std::vector<Keyframe> read_keyframes(MapReader& r, const std::string& key,
                fmt_num(out.back().time) + " s (keyframe " + std::to_string(k - 1) + ")");
     }
     kf.translate = kr.vec3("translate");
+    require_in_position_range(kf.translate, shot, kr.origin_of("translate"),
+                              kr.path_of("translate"), "the translation");
     kf.rotate_deg = kr.vec3("rotate");
     kr.finish();
     out.push_back(kf);
@@ -1328,6 +1539,7 @@ void read_render(const DocNode& node, RenderSettings& rs) {
   rs.ground_color = read_color(r, "ground_color");
   rs.pattern = r.string("pattern");
   require_one_hash_run(rs.pattern, r.origin_of("pattern"), r.path_of("pattern"));
+  require_output_file(rs.pattern, true, r.origin_of("pattern"), r.path_of("pattern"));
   if (rs.pattern.size() < 4 || rs.pattern.compare(rs.pattern.size() - 4, 4, ".png") != 0) {
     fail(r.origin_of("pattern"), r.path_of("pattern"),
          "must end in .png, got '" + rs.pattern + "'");
@@ -1358,6 +1570,38 @@ void read_shot(const DocNode& node, ShotSettings& shot) {
     d.finish();
   }
   shot.dx = r.number("dx");
+  {
+    // Every corner within the position range (float resolves 1/64 cell there).
+    const double range = kPositionRangeCells * shot.dx;
+    MapReader d(*r.block("domain"), "shot.domain", "shot.domain", false);
+    for (const char* corner : {"min", "max"}) {
+      const Vec3d c = std::string(corner) == "min" ? shot.domain_min : shot.domain_max;
+      for (int a = 0; a < 3; ++a) {
+        if (std::fabs(c[a]) <= range) continue;
+        fail(d.origin_of(corner), d.path_of(corner) + "[" + std::to_string(a) + "]",
+             std::string("coordinate ") + kAxis[a] + " = " + fmt_num(c[a]) +
+                 " m is more than 2^17 = 131072 cells of dx = " + fmt_num(shot.dx) + " m (" +
+                 fmt_num(range) +
+                 " m) from the origin, where a float position can no longer "
+                 "resolve 1/64 of a cell; move the shot towards the origin or use a larger dx");
+      }
+    }
+  }
+  // Steps a frame may take before dt_min stops the run: a bound on the work of a frame.
+  {
+    const double steps = 1.0 / (shot.fps * shot.dt_min);
+    if (!(steps <= kMaxStepsPerFrame)) {
+      // Name what the user wrote; with both, dt_min when it is below its default.
+      const bool small_dt_min = r.has("dt_min") && shot.dt_min < 1e-6;
+      const std::string at = r.has("fps") && !small_dt_min ? "fps"
+                             : r.has("dt_min")             ? "dt_min"
+                                                           : "fps";
+      fail(r.origin_of(at), r.path_of(at),
+           "a frame (1 / fps = " + fmt3(1.0 / shot.fps) + " s) may take up to " +
+               fmt_bound(std::ceil(steps)) + " steps of dt_min = " + fmt_num(shot.dt_min) +
+               " s (at most 1e7: such a run would seem to hang); raise shot.fps or shot.dt_min");
+    }
+  }
   constexpr double kMaxCells = 1 << 20;
   for (int a = 0; a < 3; ++a) {
     const double cells = (shot.domain_max[a] - shot.domain_min[a]) / shot.dx;
@@ -1401,6 +1645,29 @@ MaterialDesc read_material(const DocNode& node, const std::string& path) {
     m.critical_compression = r.number("critical_compression");
     m.critical_stretch = r.number("critical_stretch");
     m.hardening = r.number("hardening");
+  }
+  // The stiffest the material gets: its P-wave modulus, hardened snow included. Past
+  // 1e14 Pa (100x diamond) stresses times volumes and squared wave speeds near float's
+  // range; the key named is the one that makes it large.
+  {
+    const double nu = m.poisson_ratio;
+    const double ratio = (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    const double harden =
+        m.kind == MaterialKind::Snow ? std::exp(m.hardening * m.critical_compression) : 1.0;
+    const double modulus = m.youngs_modulus * ratio * harden;
+    if (!(modulus <= 1e14)) {
+      const std::string at = harden > ratio ? "hardening"
+                             : ratio > 100  ? "poisson_ratio"
+                                            : "youngs_modulus";
+      fail(r.origin_of(at), r.path_of(at),
+           "the material's stiffest modulus E (1 - nu) / ((1 + nu) (1 - 2 nu))" +
+               std::string(m.kind == MaterialKind::Snow ? " exp(hardening critical_compression)"
+                                                        : "") +
+               " is " + fmt3(modulus) + " Pa (E " + fmt_num(m.youngs_modulus) + ", nu " +
+               fmt_num(nu) +
+               (m.kind == MaterialKind::Snow ? ", hardening factor " + fmt_num(harden) : "") +
+               "); at most 1e14 Pa, past any real solid");
+    }
   }
   if (r.has("color")) m.color = read_color(r, "color");
   r.finish();
@@ -1552,7 +1819,8 @@ std::string index_range_message(long long index, long long num_vertices, const s
 }
 
 PinDesc read_pin(const DocNode& node, const std::string& path, const std::string& geometry_type,
-                 const std::string& geometry_path, long long num_vertices, double fps) {
+                 const std::string& geometry_path, long long num_vertices,
+                 const ShotSettings& shot) {
   MapReader r(node, "shells[].pins[]", path, false);
   PinDesc pin;
   const char* selectors[3] = {"indices", "box", "group"};
@@ -1607,7 +1875,7 @@ PinDesc read_pin(const DocNode& node, const std::string& path, const std::string
          "at least one of x, y, z must be true (held); all false pins nothing");
   }
   for (int a = 0; a < 3; ++a) pin.components[a] = comp[a];
-  pin.keyframes = read_keyframes(r, "keyframes", "shells[].pins[].keyframes[]", fps);
+  pin.keyframes = read_keyframes(r, "keyframes", "shells[].pins[].keyframes[]", shot);
   if (r.has("release")) pin.release_time = r.number("release");
   r.finish();
   return pin;
@@ -1646,6 +1914,36 @@ ShellDesc read_shell(const DocNode& node, std::size_t i, const Scene& scene,
   sh.scale = r.number("scale");
   sh.rotate_deg = r.vec3("rotate");
   sh.translate = r.vec3("translate");
+  require_in_position_range(sh.translate, scene.shot, r.origin_of("translate"),
+                            r.path_of("translate"), "the translation");
+  sh.placement_where = where_text(r.origin_of("translate"), r.path_of("translate"));
+  {
+    // The placed procedural mesh stays finite and near the domain (meshes from files are
+    // checked once loaded: io/scene_bounds.h); a shell thicker than its radius has
+    // inverted layers.
+    const double range = kPositionRangeCells * scene.shot.dx;
+    const double extent = sh.kind == ShellDesc::Kind::Sheet  ? std::max(sh.size[0], sh.size[1])
+                          : sh.kind == ShellDesc::Kind::Mesh ? 0.0
+                                                             : std::max(sh.radius, sh.height);
+    if (!(sh.scale * extent <= 2.0 * range)) {
+      fail(r.origin_of("geometry"), r.path_of("geometry"),
+           "the shell is " + fmt_num(sh.scale * extent) + " m across (with scale " +
+               fmt_num(sh.scale) + "), more than 2^18 cells of dx = " + fmt_num(scene.shot.dx) +
+               " m; it cannot fit in the position range");
+    }
+    const double t = scene.shell_materials[sh.material].thickness;
+    const bool curved = sh.kind == ShellDesc::Kind::Sphere || sh.kind == ShellDesc::Kind::Cylinder;
+    if (curved && !(t < sh.scale * sh.radius)) {
+      const DocNode* g = r.present("geometry");
+      const DocNode* rad = g && g->kind == DocNode::Kind::Map ? find_entry(*g, "radius") : nullptr;
+      fail(rad ? rad->origin : r.origin_of("geometry"), r.path_of("geometry") + ".radius",
+           "the shell's radius " + fmt_num(sh.scale * sh.radius) + " m (after scale) is not " +
+               "larger than the thickness " + fmt_num(t) + " m of shell material '" +
+               scene.shell_materials[sh.material].name +
+               "': its inner layers would pass through the axis (a thin shell is much thinner "
+               "than its radius)");
+    }
+  }
   sh.velocity = r.vec3("velocity");
   sh.pressure = r.number("pressure");
   const DocNode& loads = *r.block("point_loads");
@@ -1666,7 +1964,7 @@ ShellDesc read_shell(const DocNode& node, std::size_t i, const Scene& scene,
   const DocNode& pins = *r.block("pins");
   for (std::size_t k = 0; k < pins.items.size(); ++k) {
     sh.pins.push_back(read_pin(pins.items[k], r.path_of("pins") + "[" + std::to_string(k) + "]",
-                               type, r.path_of("geometry"), n, scene.shot.fps));
+                               type, r.path_of("geometry"), n, scene.shot));
   }
   sh.output_refine = r.int32("output_refine");
   sh.write_mesh = r.boolean("write_mesh");
@@ -1761,12 +2059,21 @@ Scene build_scene(const DocNode& root, const std::string& path) {
            "duplicate collider name '" + c.name + "' (also " + collider_names[c.name] + ")");
     }
     c.shape = read_shape(*r.block("shape"), r.path_of("shape"), false, path);
+    if (c.shape.kind == ShapeDesc::Kind::Plane) {
+      require_in_position_range(c.shape.point, scene.shot, r.origin_of("shape"),
+                                r.path_of("shape") + ".point", "the plane's point");
+    } else if (c.shape.kind != ShapeDesc::Kind::Mesh) {  // meshes: once loaded (scene_bounds)
+      const Aabb b = shape_bounds(c.shape);
+      for (const Vec3d& corner : {b.lo, b.hi})
+        require_in_position_range(corner, scene.shot, r.origin_of("shape"), r.path_of("shape"),
+                                  "the collider");
+    }
     const std::string boundary = r.choice("boundary");
     c.boundary = boundary == "sticky" ? BoundaryKind::Sticky
                  : boundary == "slip" ? BoundaryKind::Slip
                                       : BoundaryKind::Separate;
     c.friction = r.number("friction");
-    c.keyframes = read_keyframes(r, "keyframes", "colliders[].keyframes[]", scene.shot.fps);
+    c.keyframes = read_keyframes(r, "keyframes", "colliders[].keyframes[]", scene.shot);
     r.finish();
     scene.colliders.push_back(std::move(c));
   }
@@ -1814,17 +2121,31 @@ Scene build_scene(const DocNode& root, const std::string& path) {
     o.density_pattern = r.string("density_pattern");
     require_one_hash_run(o.density_pattern, r.origin_of("density_pattern"),
                          r.path_of("density_pattern"));
+    require_output_file(o.density_pattern, true, r.origin_of("density_pattern"),
+                        r.path_of("density_pattern"));
     o.velocity = r.boolean("velocity");
     o.half_float = r.boolean("half_float");
     o.voxel_size = r.number("voxel_size");
+    if (o.voxel_size > 0 &&
+        !(o.voxel_size >= scene.shot.dx / 8 && o.voxel_size <= 16 * scene.shot.dx)) {
+      fail(r.origin_of("voxel_size"), r.path_of("voxel_size"),
+           "must be 0 (= shot.dx) or between dx/8 and 16 dx (" + fmt_num(scene.shot.dx / 8) +
+               " .. " + fmt_num(16 * scene.shot.dx) + " m), got " + fmt_num(o.voxel_size) +
+               " (a finer volume only resamples the same particles, at up to 512x the memory)");
+    }
     o.particles = r.boolean("particles");
     o.particles_pattern = r.string("particles_pattern");
     require_one_hash_run(o.particles_pattern, r.origin_of("particles_pattern"),
                          r.path_of("particles_pattern"));
+    require_output_file(o.particles_pattern, true, r.origin_of("particles_pattern"),
+                        r.path_of("particles_pattern"));
     o.stats_file = r.string("stats");
+    require_output_file(o.stats_file, false, r.origin_of("stats"), r.path_of("stats"));
     o.checkpoint_every = r.int32("checkpoint_every");
     o.shell_pattern = r.string("shell_pattern");
     require_one_hash_run(o.shell_pattern, r.origin_of("shell_pattern"), r.path_of("shell_pattern"));
+    require_output_file(o.shell_pattern, true, r.origin_of("shell_pattern"),
+                        r.path_of("shell_pattern"));
     if (scene.shells.size() > 1 && o.shell_pattern.find("{name}") == std::string::npos) {
       fail(r.origin_of("shell_pattern"), r.path_of("shell_pattern"),
            "must contain {name} (the shell's name) when there is more than one shell (there are " +
@@ -1942,6 +2263,28 @@ void check_shell_indices(const ShellDesc& shell, int num_vertices, const std::st
 
 Scene parse_scene(const std::string& text, const std::string& path,
                   const std::vector<std::string>& overrides) {
+  // Every string of the scene can reach stats.json and run.json (names, the scene text),
+  // which are UTF-8: text that is not is refused here, for check and run alike.
+  if (const std::size_t bad = first_invalid_utf8(text); bad != std::string::npos) {
+    const Utf8Error e = locate_utf8_error(text, bad);
+    throw UserError(path, e.line, "",
+                    "not valid UTF-8: byte " + e.byte_hex + " at column " +
+                        std::to_string(e.column) +
+                        " (the key is not known: the line cannot be decoded). Scene files "
+                        "are UTF-8; a Latin-1 accent, for example, is one byte such as 0xE9. "
+                        "Convert the file, e.g. iconv -f latin1 -t utf-8");
+  }
+  for (const std::string& ov : overrides) {
+    if (const std::size_t bad = first_invalid_utf8(ov); bad != std::string::npos) {
+      const std::size_t eq = ov.find('=');
+      const std::string key = eq == std::string::npos ? "" : ov.substr(0, eq);
+      const bool in_key = eq == std::string::npos || bad < eq;
+      throw UserError("--set", 0, in_key ? "" : key,
+                      "not valid UTF-8: byte " + locate_utf8_error(ov, bad).byte_hex + " at " +
+                          "character " + std::to_string(bad + 1) + " of the override" +
+                          (in_key ? " (in its key)" : "") + "; scene values are UTF-8 text");
+    }
+  }
   DocNode root = convert(load_yaml(text, path, "", true), path, true, 0, "");
   if (root.kind == DocNode::Kind::Null) {
     throw UserError(path, 0, "", "the scene is empty; it needs at least 'version: 1' and 'shot'");
@@ -1954,6 +2297,14 @@ Scene parse_scene(const std::string& text, const std::string& path,
 }
 
 Scene read_scene(const std::string& path, const std::vector<std::string>& overrides) {
+  std::error_code abs_ec;
+  const std::string absolute = fs::absolute(path, abs_ec).lexically_normal().string();
+  if (first_invalid_utf8(path) != std::string::npos ||
+      first_invalid_utf8(absolute) != std::string::npos) {
+    throw UserError(path, 0, "",
+                    "the scene file's path is not valid UTF-8; it is written to stats.json "
+                    "and run.json, which are UTF-8: rename the file or its folder");
+  }
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw UserError(path, 0, "", "is a directory, not a scene file");
   std::ifstream in(path, std::ios::binary);

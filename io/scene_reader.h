@@ -65,6 +65,15 @@ struct KeySpec {
   std::string only_for_text() const;  ///< "sand" or "sphere, cylinder"; "-" when always allowed
 };
 
+/// Positions that place simulated things (the domain corners, collider shapes and
+/// keyframes, pin keyframes) must lie within this many cells (shot.dx) of the origin: up to
+/// 2^17 cells a float position is resolved to 1/64 of a cell (ulp(2^17 dx) = dx/64). The
+/// same bound holds in a double build, so a scene valid in one build is valid in the other.
+constexpr double kPositionRangeCells = 131072.0;  // 2^17
+
+/// The most steps one frame may take at the smallest step: 1 / (fps dt_min) <= this.
+constexpr double kMaxStepsPerFrame = 1e7;
+
 /// Every key of the scene format, in document order.
 const std::vector<KeySpec>& scene_schema();
 

@@ -183,6 +183,9 @@ struct ShellDesc {
   double scale = 1.0;
   Vec3d rotate_deg{0, 0, 0};
   Vec3d translate{0, 0, 0};
+  /// Where `translate` was given (or the shell, when it was not), as "file:line: key", for
+  /// messages about the shell's placement.
+  std::string placement_where;
   Vec3d velocity{0, 0, 0};  ///< initial velocity [m/s]
   std::vector<PinDesc> pins;
   double pressure = 0.0;    ///< surface load along the normal [Pa] (positive pushes along +normal)

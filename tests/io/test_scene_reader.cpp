@@ -353,7 +353,7 @@ TEST_CASE("overrides (--set) change the document before validation", "[scene]") 
   }
   SECTION("bad values are reported at the override") {
     expect_override_error(text, "shot.dx=abc", "shot.dx", {"expected a number, got 'abc'"});
-    expect_override_error(text, "shot.dx=-1", "shot.dx", {"must be > 0, got -1"});
+    expect_override_error(text, "shot.dx=-1", "shot.dx", {"must be in [1e-6, 1000], got -1"});
     expect_override_error(text, "shot.gravity=[0,1]", "shot.gravity",
                           {"expected a list of 3 numbers"});
     expect_override_error(text, "materials.0.type=clay", "materials[0].type",
@@ -421,13 +421,15 @@ TEST_CASE("bad scenes name the file, line and key", "[scene]") {
                  "materials[0].poisson_ratio", {"must be in [0, 0.5), got 0.5"});
     expect_error(kHead + "  dt_min: 0.1\n", 5, "shot.dt_min",
                  {"dt_max (0.01) must be >= dt_min (0.1)"});
-    expect_error("version: 1\nshot:\n  domain: {min: [0, 0, 0], max: [1, 1, 1]}\n  dx: 1e-7\n", 4,
-                 "shot.dx", {"the domain is 10000000 cells along x", "2^20"});
+    // A domain too many cells across is also too far from the origin for float (2^17 dx
+    // from it, 2^18 cells across at most): that is the error it gets.
+    expect_error("version: 1\nshot:\n  domain: {min: [0, 0, 0], max: [10, 1, 1]}\n  dx: 1e-5\n",
+                 3, "shot.domain.max[0]", {"coordinate x = 10 m", "2^17 = 131072 cells"});
     expect_error("version: 1\nshot:\n  domain: {min: [0, 0, 0], max: [1, 0, 1]}\n  dx: 0.1\n", 3,
                  "shot.domain.max", {"on y max = 0 <= min = 0"});
     const UserError e = catch_user_error([] { read_scene(kScenes + "bad_range.yaml"); });
     CHECK(std::string(e.what()) ==
-          kScenes + "bad_range.yaml:8: materials[0].density: must be > 0, got -3");
+          kScenes + "bad_range.yaml:8: materials[0].density: must be in [0.1, 100000], got -3");
   }
   SECTION("bad enum") {
     expect_error(kHead + "  transfer: flip\n", 5, "shot.transfer",
@@ -872,7 +874,7 @@ TEST_CASE("bad shell scenes name the file, line and key", "[scene][shell]") {
     expect_error(kHead + "shell_materials:\n  - {name: m, quadrature_inplane: 4}\n", 6,
                  "shell_materials[0].quadrature_inplane", {"must be one of 1, 3, 6, 7", "got 4"});
     expect_error(kHead + "shell_materials:\n  - {name: m, thickness: 0}\n", 6,
-                 "shell_materials[0].thickness", {"must be > 0, got 0"});
+                 "shell_materials[0].thickness", {"must be in [1e-7, 1], got 0"});
     expect_error(kHead + "shell_materials:\n  - {name: m, quadrature_thickness: 6}\n", 6,
                  "shell_materials[0].quadrature_thickness", {"must be in [1, 5], got 6"});
     expect_error(kHead + "shell_materials:\n  - {name: m, poisson_ratio: 0.5}\n", 6,
