@@ -221,7 +221,7 @@ std::vector<KeySpec> build_schema() {
           .required()
           .rule("its bounds (a plane: its point) within 2^17 dx of the origin"),
       Spec("colliders[].boundary", T::Enum).def("separate").choices({"sticky", "slip", "separate"}),
-      Spec("colliders[].friction", T::Number).def("0").ge(0),
+      Spec("colliders[].friction", T::Number).def("0").ge(0).le(10),
       Spec("colliders[].keyframes", T::List).def("[]").rule("times strictly increase"),
   });
   add(keyframe_specs("colliders[].keyframes[]"));
@@ -239,11 +239,11 @@ std::vector<KeySpec> build_schema() {
           .rule("< the radius of a sphere or cylinder shell"),
       Spec("shell_materials[].yield_stress", T::Number).def("0").unit("Pa").ge(0).le(1e12),
       Spec("shell_materials[].stretch_limit", T::Number).def("1.5").gt(1).le(1.9),
-      Spec("shell_materials[].damping", T::Number).def("0").unit("1/s").ge(0),
-      Spec("shell_materials[].stiffness_damping", T::Number).def("0").unit("s").ge(0),
+      Spec("shell_materials[].damping", T::Number).def("0").unit("1/s").ge(0).le(1e4),
+      Spec("shell_materials[].stiffness_damping", T::Number).def("0").unit("s").ge(0).le(1),
       Spec("shell_materials[].quadrature_inplane", T::Int).def("3").rule("one of: 1, 3, 6, 7"),
       Spec("shell_materials[].quadrature_thickness", T::Int).def("3").ge(1).le(5),
-      Spec("shell_materials[].friction", T::Number).def("0.3").ge(0),
+      Spec("shell_materials[].friction", T::Number).def("0.3").ge(0).le(10),
       Spec("shell_materials[].contact_stiffness", T::Number)
           .optional("`youngs_modulus`")
           .unit("Pa")
