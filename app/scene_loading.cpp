@@ -1,9 +1,9 @@
 #include "app/scene_loading.h"
 
 #include <fstream>
-#include <regex>
 #include <sstream>
 
+#include "app/frame_range.h"
 #include "io/available_memory.h"
 #include "io/checkpoint.h"
 #include "io/mesh_sdf.h"
@@ -29,15 +29,9 @@ LoadedScene load_scene_for_cli(const CommonArgs& a, const std::string& frames,
   }
   ShotSettings& shot = ls.scene.shot;
   if (!frames.empty()) {
-    std::smatch m;
-    const std::regex re(R"((\d+)(?:-(\d+))?)");
-    if (!std::regex_match(frames, m, re))
-      throw UserError("--frames " + frames, 0, "", "expected A-B or A with frame numbers >= 1");
-    const int a0 = std::stoi(m[1]);
-    const int b0 = m[2].matched ? std::stoi(m[2]) : a0;
-    if (a0 < 1 || b0 < a0) throw UserError("--frames " + frames, 0, "", "need 1 <= A <= B");
-    shot.frame_start = a0;
-    shot.frame_end = b0;
+    const FrameRange r = parse_frames_flag(frames);
+    shot.frame_start = r.first;
+    shot.frame_end = r.last;
   }
   if (!output.empty()) ls.scene.output.directory = output;
   if (a.threads >= 0) shot.threads = a.threads;

@@ -15,6 +15,8 @@ void ColliderParticlesStage::run(StepContext& c) {
                            c.opt.serial);
   for (GridShell& g : c.grid_shells)
     project_out_of_colliders(c.colliders, dx, c.dt, g.shell->x, g.shell->v, &g.held, c.opt.serial);
+  // A collider can push a point past the domain's last cell: back inside, as after g2p.
+  c.clamp_to_domain();
 }
 
 }  // namespace shellmpm
