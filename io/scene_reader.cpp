@@ -142,7 +142,7 @@ std::vector<KeySpec> build_schema() {
       Spec("output", T::Map).def("{}"),
       Spec("render", T::Map).def("{}"),
       // shot
-      Spec("shot.frames", T::FrameRange).def("[1, 48]").ge(1),
+      Spec("shot.frames", T::FrameRange).def("[1, 48]").ge(1).le(999999999),  // = kMaxFrameNumber
       Spec("shot.fps", T::Number).def("24").unit("1/s").ge(0.01).le(1e5),
       Spec("shot.cfl", T::Number).def("0.3").gt(0).le(1),
       Spec("shot.dt_min", T::Number)
@@ -211,7 +211,7 @@ std::vector<KeySpec> build_schema() {
       Spec("sources[].emit", T::Map)
           .optional("none: fill once at the start")
           .rule("velocity must be nonzero"),
-      Spec("sources[].emit.frames", T::FrameRange).required().ge(1),
+      Spec("sources[].emit.frames", T::FrameRange).required().ge(1).le(999999999),
       // colliders
       Spec("colliders[].name", T::String)
           .optional("`collider<i>` (i = list index)")
