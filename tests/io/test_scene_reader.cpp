@@ -414,7 +414,10 @@ TEST_CASE("bad scenes name the file, line and key", "[scene]") {
   }
   SECTION("out-of-range values") {
     expect_error(kHead + "  cfl: 1.5\n", 5, "shot.cfl", {"must be in (0, 1], got 1.5"});
-    expect_error(kHead + "  frames: [0, 10]\n", 5, "shot.frames[0]", {"must be >= 1, got 0"});
+    expect_error(kHead + "  frames: [0, 10]\n", 5, "shot.frames[0]",
+                 {"must be in [1, 999999999], got 0"});
+    expect_error(kHead + "  frames: [1, 1000000000]\n", 5, "shot.frames[1]",
+                 {"must be in [1, 999999999], got 1000000000"});
     expect_error(kHead + "  frames: [10, 5]\n", 5, "shot.frames",
                  {"last frame 5 is before first frame 10"});
     expect_error(kHead + "materials:\n  - {name: m, type: elastic, poisson_ratio: 0.5}\n", 6,
