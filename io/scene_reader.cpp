@@ -469,6 +469,18 @@ std::string join(const std::vector<std::string>& v, const char* sep = ", ") {
   return out;
 }
 
+/// "1e+20" -> "1e20", "1e-06" -> "1e-6": the exponent without sign or leading zeros.
+std::string tidy_exponent(std::string s) {
+  const std::size_t e = s.find('e');
+  if (e != std::string::npos) {
+    std::size_t d = e + 1;
+    if (s[d] == '+') s.erase(d, 1);
+    if (s[d] == '-') ++d;
+    while (d + 1 < s.size() && s[d] == '0') s.erase(d, 1);
+  }
+  return s;
+}
+
 /// Shortest text that reads back as the same double ("0.5", "90", "4294967295", "1e-6").
 std::string fmt_num(double x) {
   char buf[64];
@@ -481,14 +493,7 @@ std::string fmt_num(double x) {
     if (std::strtod(buf, nullptr) == x) break;
   }
   std::string s = buf;  // "1e-06" -> "1e-6", "1e+20" -> "1e20"
-  const std::size_t e = s.find('e');
-  if (e != std::string::npos) {
-    std::size_t d = e + 1;
-    if (s[d] == '+') s.erase(d, 1);
-    if (s[d] == '-') ++d;
-    while (d + 1 < s.size() && s[d] == '0') s.erase(d, 1);
-  }
-  return s;
+  return tidy_exponent(s);
 }
 
 /// Three significant digits ("0.0417", "1.67e14").
@@ -496,14 +501,7 @@ std::string fmt3(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", x);
   std::string s = buf;  // "1.67e+14" -> "1.67e14", "1e-07" -> "1e-7"
-  const std::size_t e = s.find('e');
-  if (e != std::string::npos) {
-    std::size_t d = e + 1;
-    if (s[d] == '+') s.erase(d, 1);
-    if (s[d] == '-') ++d;
-    while (d + 1 < s.size() && s[d] == '0') s.erase(d, 1);
-  }
-  return s;
+  return tidy_exponent(s);
 }
 
 /// fmt_num, but a whole number from 1e6 on as "1e12" when that is shorter (tables).

@@ -12,6 +12,22 @@
 
 namespace shellmpm_test {
 
+/// A tiny bulk scene (two frames of an elastic box at 240 fps); OUT stands for the output
+/// directory.
+inline const char* const kTinyJellyScene = R"(version: 1
+shot:
+  frames: [1, 2]
+  fps: 240
+  dx: 0.05
+  domain: {min: [-0.5, 0, -0.5], max: [0.5, 1, 0.5]}
+materials:
+  - {name: jelly, type: elastic, youngs_modulus: 1.0e4, density: 1000}
+sources:
+  - {material: jelly, shape: {type: box, min: [-0.1, 0.3, -0.1], max: [0.1, 0.5, 0.1]}}
+output:
+  directory: OUT
+)";
+
 struct CmdResult {
   int code = -1;
   std::string output;  ///< stdout and stderr together
@@ -30,7 +46,6 @@ inline CmdResult run_shellmpm(const std::string& args) {
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
-
 
 inline std::string read_text(const std::string& path) {
   std::ifstream f(path, std::ios::binary);

@@ -20,19 +20,6 @@ using namespace shellmpm_test;
 
 namespace {
 
-const char* kJelly = R"(version: 1
-shot:
-  frames: [1, 2]
-  fps: 240
-  dx: 0.05
-  domain: {min: [-0.5, 0, -0.5], max: [0.5, 1, 0.5]}
-materials:
-  - {name: jelly, type: elastic, youngs_modulus: 1.0e4, density: 1000}
-sources:
-  - {material: jelly, shape: {type: box, min: [-0.1, 0.3, -0.1], max: [0.1, 0.5, 0.1]}}
-output:
-  directory: OUT
-)";
 
 std::string write_scene(const TempDir& d, std::string text, const std::string& name = "s.yaml") {
   const auto at = text.find("OUT");
@@ -79,7 +66,7 @@ double peak_rss(const std::vector<std::string>& args) {
 TEST_CASE("CLI memory: run refuses a scene larger than the available memory",
           "[cli][memory_guard]") {
   TempDir d("cli_memory");
-  const std::string s = write_scene(d, kJelly);
+  const std::string s = write_scene(d, kTinyJellyScene);
   {
     Available tiny("1K");  // the scene needs some 100 KiB more than the process holds
     const CmdResult c = run_shellmpm("check " + s);

@@ -14,20 +14,6 @@ namespace {
 
 const std::string kCloth = std::string(SHELLMPM_SOURCE_DIR) + "/scenes/cloth_swing.yaml";
 
-// A tiny bulk scene; OUT is replaced by the output directory.
-const char* kJelly = R"(version: 1
-shot:
-  frames: [1, 2]
-  fps: 240
-  dx: 0.05
-  domain: {min: [-0.5, 0, -0.5], max: [0.5, 1, 0.5]}
-materials:
-  - {name: jelly, type: elastic, youngs_modulus: 1.0e4, density: 1000}
-sources:
-  - {material: jelly, shape: {type: box, min: [-0.1, 0.3, -0.1], max: [0.1, 0.5, 0.1]}}
-output:
-  directory: OUT
-)";
 
 std::string write_scene(const TempDir& d, std::string text, const std::string& extra = "") {
   text.replace(text.find("OUT"), 3, d.file("out"));
@@ -74,7 +60,7 @@ TEST_CASE("CLI values: float overflow and degenerate timing are exit 2 at their 
 
 TEST_CASE("CLI values: the edges of the ranges run without an internal error", "[cli][values]") {
   TempDir d("cli_edges");
-  const std::string s = write_scene(d, kJelly,
+  const std::string s = write_scene(d, kTinyJellyScene,
                                     "shell_materials:\n"
                                     "  - {name: foil}\n"
                                     "shells:\n"
@@ -103,7 +89,7 @@ TEST_CASE("CLI values: the edges of the ranges run without an internal error", "
 
 TEST_CASE("CLI values: output names with folders are created before the run", "[cli][values]") {
   TempDir d("cli_folders");
-  const std::string s = write_scene(d, kJelly,
+  const std::string s = write_scene(d, kTinyJellyScene,
                                     "  stats: logs/stats.json\n"
                                     "  density_pattern: vdb/density.####.vdb\n"
                                     "  particles: true\n"
@@ -126,7 +112,7 @@ TEST_CASE("CLI values: output names with folders are created before the run", "[
 TEST_CASE("CLI values: a Latin-1 comment is refused at its line by check and run",
           "[cli][values]") {
   TempDir d("cli_latin1");
-  const std::string s = write_scene(d, kJelly, "# r\xe9sum\xe9 of the shot\n");
+  const std::string s = write_scene(d, kTinyJellyScene, "# r\xe9sum\xe9 of the shot\n");
   for (const char* cmd : {"check ", "run "}) {
     const CmdResult r = run_shellmpm(std::string(cmd) + s);
     INFO(r.output);
@@ -139,7 +125,7 @@ TEST_CASE("CLI values: a Latin-1 comment is refused at its line by check and run
 
 TEST_CASE("CLI values: an unquoted pattern in --set says how to quote it", "[cli][values]") {
   TempDir d("cli_quote");
-  const std::string s = write_scene(d, kJelly);
+  const std::string s = write_scene(d, kTinyJellyScene);
   const CmdResult r =
       run_shellmpm("check " + s + " --set " + sh("output.shell_pattern={name}.####.ply"));
   INFO(r.output);
