@@ -167,6 +167,13 @@ std::vector<KeySpec> build_schema() {
       Spec("shot.threads", T::Int).def("0").ge(0),
       Spec("shot.transfer", T::Enum).def("apic").choices({"apic", "mls"}),
       Spec("shot.shell_velocities", T::Enum).def("per_shell").choices({"per_shell", "shared"}),
+      Spec("shot.shell_guard", T::Bool).def("true"),
+      Spec("shot.shell_guard_gap", T::Number)
+          .def("0")
+          .unit("m")
+          .ge(0)
+          .le(1e3)
+          .rule("0: the larger of 0.05 dx and the thickest contact shell"),
       Spec("shot.units", T::String).def("m").nonempty(),
       Spec("shot.on_integrity_failure", T::Enum).def("warn").choices({"warn", "stop"}),
       // materials
@@ -1612,6 +1619,8 @@ void read_shot(const DocNode& node, ShotSettings& shot) {
   shot.threads = r.int32("threads");
   shot.transfer = r.choice("transfer");
   shot.shared_shell_velocity = r.choice("shell_velocities") == "shared";
+  shot.shell_guard = r.boolean("shell_guard");
+  shot.shell_guard_gap = r.number("shell_guard_gap");
   shot.units = r.string("units");
   shot.on_integrity_failure = r.choice("on_integrity_failure") == "stop"
                                   ? ShotSettings::OnIntegrityFailure::Stop

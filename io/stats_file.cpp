@@ -33,6 +33,10 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     j["contact_sliding"] = s.contact_sliding;
     j["contact_energy"] = s.contact_energy;
     j["friction_work"] = s.friction_work;
+    j["guard_pairs"] = s.guard_pairs;
+    j["guard_impulses"] = s.guard_impulses;
+    j["guard_zoned"] = s.guard_zoned;
+    j["guard_unresolved"] = s.guard_unresolved;
   }
   if (s.integrity.active) {
     const IntegrityReport& r = s.integrity;

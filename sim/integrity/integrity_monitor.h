@@ -29,7 +29,7 @@
 
 #include "sim/collider/collider.h"
 #include "sim/integrity/integrity_report.h"
-#include "sim/integrity/triangle_queries.h"
+#include "sim/math/triangle_queries.h"
 #include "sim/mpm/particles.h"
 #include "sim/shell/limit_mesh.h"
 #include "sim/shell/shell_object.h"

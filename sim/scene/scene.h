@@ -29,6 +29,10 @@ struct ShotSettings {
   /// True: shells that share grid nodes share one velocity there (no-slip between them,
   /// as in the paper); false: each keeps its own (ShellFields), friction from contact only.
   bool shared_shell_velocity = false;
+  /// The shell guard (sim/contact/shell_guard.h): stops contact shells from closing
+  /// closer than shell_guard_gap where the grid cannot hold them apart.
+  bool shell_guard = true;
+  double shell_guard_gap = 0;     ///< [m]; 0: the larger of 0.05 dx and the thickest contact shell
   std::string units = "m";        ///< informational, written to VDB metadata
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).

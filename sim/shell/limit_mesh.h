@@ -19,6 +19,10 @@ class LimitMesh {
   std::size_t num_vertices() const { return rows_.size(); }
   const std::vector<Eigen::Vector3i>& triangles() const { return tris_; }
   const std::vector<Eigen::Vector2d>& uvs() const { return uvs_; }
+  /// Output vertex r as a combination of control points: its position is
+  /// sum_k row_weights(r)[k] x[row_points(r)[k]] (the weights sum to 1).
+  const std::vector<int>& row_points(std::size_t r) const { return rows_[r].ctrl; }
+  const std::vector<Real>& row_weights(std::size_t r) const { return rows_[r].n; }
   /// Limit positions and unit normals of the output vertices for control points x.
   void evaluate(const Vec3* x, std::vector<Vec3>& pos, std::vector<Vec3>& normal) const;
 

@@ -35,6 +35,11 @@ struct FrameStats {
   std::size_t contact_sliding = 0;     ///< sliding in the frame's last step
   double contact_energy = 0;           ///< sum V psi [J]
   double friction_work = 0;            ///< dissipated by sliding friction since the start [J]
+  // The shell guard (sim/contact/shell_guard.h) over the frame's steps.
+  std::size_t guard_pairs = 0;       ///< most proximity pairs in one step
+  std::size_t guard_impulses = 0;    ///< pair impulses applied, summed over the steps
+  std::size_t guard_zoned = 0;       ///< points moved in impact zones, summed
+  std::size_t guard_unresolved = 0;  ///< pairs left closing at a step's end, summed
   /// What the integrity monitor found (crossings, collider penetration, non-finite).
   IntegrityReport integrity;
   /// Wall-clock seconds per stage, in stage order (not deterministic, unlike the rest).

@@ -147,6 +147,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   using clock = std::chrono::steady_clock;
   const auto wall0 = clock::now();
   for (Slot& st : stages_) st.seconds = 0;
+  c_.guard_frame = ShellGuardStats{};
   FrameStats fs;
   fs.dt_min = 1e300;
   double dt_seconds = 0, integrity_seconds = 0;
@@ -208,6 +209,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   if (c_.particles.size() > 0) {
     c_.grid.bin(c_.particles.x, c_.opt.serial);
     c_.particles.permute(c_.grid.order);
+    ++c_.particle_epoch;
   }
   const double reorder_seconds = std::chrono::duration<double>(clock::now() - r0).count();
   fs.time = c_.time;
@@ -274,6 +276,10 @@ void Solver::measure(FrameStats& s) const {
   s.contact_compressed = c_.contact_step.compressed;
   s.contact_sliding = c_.contact_step.sliding;
   s.friction_work = c_.friction_work;
+  s.guard_pairs = c_.guard_frame.pairs;
+  s.guard_impulses = c_.guard_frame.impulses;
+  s.guard_zoned = c_.guard_frame.zoned;
+  s.guard_unresolved = c_.guard_frame.unresolved;
   s.kinetic_energy = total.ke;
   s.elastic_energy = total.pe;
   s.mass = total.m;

@@ -9,6 +9,7 @@
 #include "sim/collider/collider.h"
 #include "sim/contact/shell_contact.h"
 #include "sim/contact/shell_fields.h"
+#include "sim/contact/shell_guard.h"
 #include "sim/contact/shell_transfer.h"
 #include "sim/mpm/constitutive.h"
 #include "sim/mpm/particles.h"
@@ -46,6 +47,9 @@ struct StepContext {
   // Bulk particles. p2g reads; g2p writes x, v, C, F; plasticity writes F and plastic;
   // emit appends.
   ParticleSet particles;
+  /// Counts the reorderings of `particles` (the solver's per-frame sort; stages that keep
+  /// particle indices across steps compare it).
+  std::uint64_t particle_epoch = 0;
   // The combined grid. bin writes the binning; p2g writes mass and momentum; grid turns
   // momentum into velocity; contact_grid, colliders and g2p (shared nodes) change
   // velocities; g2p reads.
@@ -67,6 +71,9 @@ struct StepContext {
   // Accumulated results (checkpointed): friction writes contact_step and friction_work,
   // denting writes plastic_work.
   ContactStepStats contact_step;  ///< the last step's return mapping
+  /// shell_guard's counts over the frame so far (the solver zeroes it at a frame's start):
+  /// pairs and sweeps are maxima over the steps, impulses, zoned and unresolved sums.
+  ShellGuardStats guard_frame;
   double friction_work = 0;       ///< [J]
   double plastic_work = 0;        ///< [J]
 

@@ -13,6 +13,7 @@
 #include "sim/solver/stages/grid_update.h"
 #include "sim/solver/stages/p2g.h"
 #include "sim/solver/stages/shell_forces.h"
+#include "sim/solver/stages/shell_guard.h"
 #include "sim/solver/stages/shell_update.h"
 
 namespace shellmpm {
@@ -29,7 +30,8 @@ Entry entry() {
 }
 
 // Execution order. Shell forces come first (the transfer carries them), the grid stages
-// in the order of one MPM step, then the shells' denting and the emission of new
+// in the order of one MPM step (the shell guard right after G2P has moved the control
+// points, before colliders project points out), then the shells' denting and the emission of new
 // particles for the next step.
 const std::vector<Entry>& registry() {
   static const std::vector<Entry> table = {
@@ -37,7 +39,8 @@ const std::vector<Entry>& registry() {
       entry<ContactForcesStage>(), entry<BinStage>(),
       entry<P2gStage>(),           entry<GridUpdateStage>(),
       entry<ContactGridStage>(),   entry<CollidersStage>(),
-      entry<G2pStage>(),           entry<ColliderParticlesStage>(),
+      entry<G2pStage>(),           entry<ShellGuardStage>(),
+      entry<ColliderParticlesStage>(),
       entry<FrictionStage>(),      entry<BulkPlasticityStage>(),
       entry<DentingStage>(),       entry<EmitStage>(),
   };

@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "sim/integrity/integrity_monitor.h"
-#include "sim/integrity/triangle_queries.h"
+#include "sim/math/triangle_queries.h"
 #include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;

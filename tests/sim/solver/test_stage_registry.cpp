@@ -81,7 +81,12 @@ TEST_CASE("a shell with self-contact runs the contact pipeline on the grid", "[s
   Scene s = base_scene();
   add_sheet(s, "a", 0, ShellDesc::Contact::On);
   REQUIRE(stages_of(s) == Names{"shell_forces", "contact", "bin", "p2g", "grid", "contact_grid",
+                                "g2p", "shell_guard", "friction"});
+  // The shell guard is on by default and goes with shot.shell_guard: false.
+  s.shot.shell_guard = false;
+  REQUIRE(stages_of(s) == Names{"shell_forces", "contact", "bin", "p2g", "grid", "contact_grid",
                                 "g2p", "friction"});
+  s.shot.shell_guard = true;
   // A denting material adds the denting stage after the step.
   s.shell_materials[0].yield_stress = 1e6;
   REQUIRE(stages_of(s).back() == "denting");
@@ -94,7 +99,7 @@ TEST_CASE("two shells: auto contact goes on, a shell kept off still updates dire
   REQUIRE(shell_has_contact(s, 0));
   REQUIRE_FALSE(shell_has_contact(s, 1));
   REQUIRE(stages_of(s) == Names{"shell_forces", "shell_update", "contact", "bin", "p2g", "grid",
-                                "contact_grid", "g2p", "friction"});
+                                "contact_grid", "g2p", "shell_guard", "friction"});
 }
 
 TEST_CASE("bulk material: elastic needs no plasticity, sand does, emission adds emit", "[stages]") {
@@ -120,7 +125,8 @@ TEST_CASE("every registered stage is reachable, once, in one execution order", "
   add_ground(s);
   const Names all = stages_of(s);
   REQUIRE(all == Names{"shell_forces", "shell_update", "contact", "bin", "p2g", "grid",
-                       "contact_grid", "colliders", "g2p", "collider_particles", "friction",
+                       "contact_grid", "colliders", "g2p", "shell_guard", "collider_particles",
+                       "friction",
                        "plasticity", "denting", "emit"});
   REQUIRE(std::set<std::string>(all.begin(), all.end()).size() == all.size());
   // And nothing to simulate: no stage at all.

@@ -1,8 +1,9 @@
-// Geometric queries on triangle meshes for the integrity monitor: closest points,
+// Geometric queries on triangle meshes (the integrity monitor, the shell guard): closest points,
 // segment-triangle intersection and a uniform grid of triangles for neighbour search.
 // Double precision throughout: the monitor judges the float state, it must not add
 // round-off of its own.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -14,6 +15,12 @@ namespace shellmpm {
 /// sec. 5.1.5): returns the barycentric coordinates (u, v, w) of the closest point,
 /// u a + v b + w c, all in [0, 1] and summing to 1.
 Vec3d closest_point_barycentric(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c);
+
+/// Closest points of the segments [p0, p1] and [q0, q1] (Ericson sec. 5.1.9): returns
+/// (s, t) in [0, 1]^2 with p0 + s (p1 - p0) and q0 + t (q1 - q0) closest. Parallel
+/// segments give one of the closest pairs; degenerate segments are points.
+Eigen::Vector2d closest_segment_params(const Vec3d& p0, const Vec3d& p1, const Vec3d& q0,
+                                       const Vec3d& q1);
 
 /// Whether the segment [p, q] crosses the triangle (a, b, c) (Moller-Trumbore, both end
 /// points included); segments in the triangle's plane count as not crossing.
@@ -30,6 +37,20 @@ class TriangleGrid {
   void query(const Vec3d& p, std::vector<int>& out) const;
   /// Triangles listed in any cell that the box [lo, hi] overlaps, sorted, no repeats.
   void query_box(const Vec3d& lo, const Vec3d& hi, std::vector<int>& out) const;
+  /// Calls fn(triangle) for every listing in the cells that the box [lo, hi] overlaps,
+  /// in cell order; a triangle listed in several of them is visited once per cell.
+  template <class Fn>
+  void for_each_in_box(const Vec3d& lo, const Vec3d& hi, Fn&& fn) const {
+    if (!lo.allFinite() || !hi.allFinite()) return;
+    const Vec3i c0 = cell_of(lo), c1 = cell_of(hi);
+    for (int i = c0[0]; i <= c1[0]; ++i)
+      for (int j = c0[1]; j <= c1[1]; ++j)
+        for (int k = c0[2]; k <= c1[2]; ++k) {
+          const std::uint64_t key_ijk = key(Vec3i(i, j, k));
+          auto it = std::lower_bound(keys_.begin(), keys_.end(), key_ijk);
+          for (; it != keys_.end() && *it == key_ijk; ++it) fn(tri_[it - keys_.begin()]);
+        }
+  }
   bool empty() const { return keys_.empty(); }
 
  private:

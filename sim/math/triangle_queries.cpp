@@ -1,4 +1,4 @@
-#include "sim/integrity/triangle_queries.h"
+#include "sim/math/triangle_queries.h"
 
 #include <algorithm>
 #include <cmath>
@@ -35,6 +35,29 @@ Vec3d closest_point_barycentric(const Vec3d& p, const Vec3d& a, const Vec3d& b, 
   if (!std::isfinite(denom)) return {1, 0, 0};  // degenerate triangle
   const double v = vb * denom, w = vc * denom;
   return {1 - v - w, v, w};
+}
+
+Eigen::Vector2d closest_segment_params(const Vec3d& p0, const Vec3d& p1, const Vec3d& q0,
+                                       const Vec3d& q1) {
+  const Vec3d d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  const double tiny = 1e-300;
+  if (a <= tiny && e <= tiny) return {0, 0};
+  if (a <= tiny) return {0, std::clamp(f / e, 0.0, 1.0)};
+  const double c = d1.dot(r);
+  if (e <= tiny) return {std::clamp(-c / a, 0.0, 1.0), 0};
+  const double b = d1.dot(d2), denom = a * e - b * b;
+  // Parallel segments (denom ~ 0): any s; take 0.
+  double s = denom > 1e-14 * a * e ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+  double t = (b * s + f) / e;
+  if (t < 0) {
+    t = 0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+  } else if (t > 1) {
+    t = 1;
+    s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+  return {s, t};
 }
 
 bool segment_crosses_triangle(const Vec3d& p, const Vec3d& q, const Vec3d& a, const Vec3d& b,

@@ -1,0 +1,514 @@
+#include "sim/contact/shell_guard.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace shellmpm {
+namespace {
+
+Vec3d to_d(const Vec3& v) { return v.cast<double>(); }
+
+/// Unique undirected edges of a triangle list, sorted.
+std::vector<Eigen::Vector2i> unique_edges(const std::vector<Eigen::Vector3i>& tris) {
+  std::vector<Eigen::Vector2i> e;
+  e.reserve(tris.size() * 3);
+  for (const Eigen::Vector3i& t : tris)
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      e.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  const auto less = [](const Eigen::Vector2i& x, const Eigen::Vector2i& y) {
+    return x[0] != y[0] ? x[0] < y[0] : x[1] < y[1];
+  };
+  std::sort(e.begin(), e.end(), less);
+  e.erase(std::unique(e.begin(), e.end()), e.end());
+  return e;
+}
+
+/// Whether the boxes of the point sets a and b are farther apart than r on some axis (a
+/// cheap test before an exact distance).
+template <std::size_t NA, std::size_t NB>
+bool boxes_apart(const std::array<const Vec3d*, NA>& a, const std::array<const Vec3d*, NB>& b,
+                 double r) {
+  for (int ax = 0; ax < 3; ++ax) {
+    double alo = (*a[0])[ax], ahi = alo, blo = (*b[0])[ax], bhi = blo;
+    for (std::size_t i = 1; i < NA; ++i) {
+      alo = std::min(alo, (*a[i])[ax]);
+      ahi = std::max(ahi, (*a[i])[ax]);
+    }
+    for (std::size_t i = 1; i < NB; ++i) {
+      blo = std::min(blo, (*b[i])[ax]);
+      bhi = std::max(bhi, (*b[i])[ax]);
+    }
+    if (blo - ahi >= r || alo - bhi >= r) return true;
+  }
+  return false;
+}
+
+double distance_to_triangle(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d w = closest_point_barycentric(p, a, b, c);
+  return (p - (w[0] * a + w[1] * b + w[2] * c)).norm();
+}
+
+double distance_of_segments(const Vec3d& p0, const Vec3d& p1, const Vec3d& q0, const Vec3d& q1) {
+  const Eigen::Vector2d st = closest_segment_params(p0, p1, q0, q1);
+  return ((p0 + st[0] * (p1 - p0)) - (q0 + st[1] * (q1 - q0))).norm();
+}
+
+}  // namespace
+
+void ShellGuard::setup(const std::vector<GridShell>& shells, double gap) {
+  gap_ = gap;
+  meshes_.clear();
+  point_offset_.assign(1, 0);
+  vertex_offset_.assign(1, 0);
+  for (const GridShell& g : shells) {
+    const ShellObject& sh = *g.shell;
+    Mesh m;
+    m.limit = std::make_unique<LimitMesh>(sh.basis(), sh.triangles(),
+                                          std::vector<Eigen::Vector2d>{}, 0);
+    m.edges = unique_edges(m.limit->triangles());
+    std::vector<Vec3> rest_x(sh.rest.size());
+    for (std::size_t i = 0; i < rest_x.size(); ++i) rest_x[i] = sh.rest[i].cast<Real>();
+    std::vector<Vec3> rp, rn;
+    m.limit->evaluate(rest_x.data(), rp, rn);
+    m.rest.resize(rp.size());
+    for (std::size_t i = 0; i < rp.size(); ++i) m.rest[i] = to_d(rp[i]);
+    double edge_sum = 0;
+    for (const Eigen::Vector2i& e : m.edges) edge_sum += (m.rest[e[0]] - m.rest[e[1]]).norm();
+    m.near = std::max(2.0 * gap, m.edges.empty() ? 0.0 : edge_sum / m.edges.size());
+    point_offset_.push_back(point_offset_.back() + sh.size());
+    vertex_offset_.push_back(vertex_offset_.back() + m.limit->num_vertices());
+    meshes_.push_back(std::move(m));
+  }
+  vert_shell_.clear();
+  for (std::size_t s = 0; s < meshes_.size(); ++s)
+    vert_shell_.resize(vertex_offset_[s + 1], s);
+  shell_list_ = {};
+  bulk_list_ = {};
+  all_tris_.clear();
+  all_edges_.clear();
+  for (std::size_t s = 0; s < meshes_.size(); ++s) {
+    const int o = static_cast<int>(vertex_offset_[s]);
+    for (const Eigen::Vector3i& t : meshes_[s].limit->triangles())
+      all_tris_.emplace_back(t[0] + o, t[1] + o, t[2] + o);
+    for (const Eigen::Vector2i& e : meshes_[s].edges)
+      all_edges_.emplace_back(e[0] + o, e[1] + o, e[1] + o);
+  }
+}
+
+void ShellGuard::add_vertex(std::size_t s, int v, double scale) {
+  const LimitMesh& L = *meshes_[s].limit;
+  const std::vector<int>& pts = L.row_points(static_cast<std::size_t>(v));
+  const std::vector<Real>& w = L.row_weights(static_cast<std::size_t>(v));
+  for (std::size_t k = 0; k < pts.size(); ++k)
+    entries_.push_back({point_offset_[s] + static_cast<std::size_t>(pts[k]),
+                        scale * static_cast<double>(w[k])});
+}
+
+void ShellGuard::add_pair(const Vec3d& n, double d, double dt) {
+  Pair p;
+  p.begin = pairs_.empty() ? 0 : pairs_.back().end;
+  // Merge the entries of one control point (sorted by point, so the sums have a fixed
+  // order).
+  std::sort(entries_.begin() + static_cast<std::ptrdiff_t>(p.begin), entries_.end(),
+            [](const Entry& a, const Entry& b) { return a.point < b.point; });
+  std::size_t out = p.begin;
+  for (std::size_t i = p.begin; i < entries_.size(); ++i) {
+    if (out > p.begin && entries_[out - 1].point == entries_[i].point)
+      entries_[out - 1].w += entries_[i].w;
+    else
+      entries_[out++] = entries_[i];
+  }
+  entries_.resize(out);
+  p.end = out;
+  p.n = n;
+  p.target = -std::max(d - gap_, 0.0) / dt;
+  p.denom = 0;
+  for (std::size_t i = p.begin; i < p.end; ++i) {
+    const Vec3d& im = inv_mass_[entries_[i].point];
+    p.denom += entries_[i].w * entries_[i].w * (n.cwiseProduct(n)).dot(im);
+  }
+  pairs_.push_back(p);
+}
+
+double ShellGuard::cell_size(double radius) const {
+  // About one mesh edge, at least the radius: each feature is binned by its own box and
+  // a query looks in the box grown by the radius.
+  double edge_sum = 0;
+  for (const Eigen::Vector3i& e : all_edges_) edge_sum += (pos_[e[0]] - pos_[e[1]]).norm();
+  return std::max(radius, all_edges_.empty() ? radius : edge_sum / all_edges_.size());
+}
+
+void ShellGuard::build_shell_candidates(double radius) {
+  vt_cand_.clear();
+  ee_cand_.clear();
+  const double cell = cell_size(radius);
+  tri_grid_.build(pos_, all_tris_, cell, 0.0);
+  edge_grid_.build(pos_, all_edges_, cell, 0.0);
+  const Vec3d pad = Vec3d::Constant(radius);
+  const auto local = [&](std::size_t g) {
+    return static_cast<int>(g - vertex_offset_[vert_shell_[g]]);
+  };
+  std::vector<int> cand;
+  stamp_.assign(std::max(all_tris_.size(), all_edges_.size()), -1);
+  for (std::size_t p = 0; p < pos_.size(); ++p) {
+    const int pi = static_cast<int>(p);
+    cand.clear();
+    tri_grid_.for_each_in_box(pos_[p] - pad, pos_[p] + pad, [&](int t) {
+      if (stamp_[static_cast<std::size_t>(t)] == pi) return;
+      stamp_[static_cast<std::size_t>(t)] = pi;
+      const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
+      if (T[0] == pi || T[1] == pi || T[2] == pi) return;
+      if (boxes_apart<1, 3>({&pos_[p]}, {&pos_[T[0]], &pos_[T[1]], &pos_[T[2]]}, radius)) return;
+      if (!(distance_to_triangle(pos_[p], pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius)) return;
+      const std::size_t s = vert_shell_[p];
+      if (s == vert_shell_[T[0]]) {
+        const std::vector<Vec3d>& R = meshes_[s].rest;
+        if (distance_to_triangle(R[local(p)], R[local(T[0])], R[local(T[1])], R[local(T[2])]) <
+            meshes_[s].near)
+          return;
+      }
+      cand.push_back(t);
+    });
+    std::sort(cand.begin(), cand.end());
+    for (int t : cand) vt_cand_.emplace_back(pi, t);
+  }
+  stamp_.assign(stamp_.size(), -1);
+  for (std::size_t e = 0; e < all_edges_.size(); ++e) {
+    const Eigen::Vector3i& E = all_edges_[e];
+    const Vec3d &p0 = pos_[E[0]], &p1 = pos_[E[1]];
+    const int ei = static_cast<int>(e);
+    cand.clear();
+    edge_grid_.for_each_in_box(p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad, [&](int f) {
+      if (f <= ei || stamp_[static_cast<std::size_t>(f)] == ei) return;
+      stamp_[static_cast<std::size_t>(f)] = ei;
+      const Eigen::Vector3i& F = all_edges_[static_cast<std::size_t>(f)];
+      if (F[0] == E[0] || F[0] == E[1] || F[1] == E[0] || F[1] == E[1]) return;
+      if (boxes_apart<2, 2>({&p0, &p1}, {&pos_[F[0]], &pos_[F[1]]}, radius)) return;
+      if (!(distance_of_segments(p0, p1, pos_[F[0]], pos_[F[1]]) < radius)) return;
+      const std::size_t s = vert_shell_[E[0]];
+      if (s == vert_shell_[F[0]]) {
+        const std::vector<Vec3d>& R = meshes_[s].rest;
+        if (distance_of_segments(R[local(E[0])], R[local(E[1])], R[local(F[0])],
+                                 R[local(F[1])]) < meshes_[s].near)
+          return;
+      }
+      cand.push_back(f);
+    });
+    std::sort(cand.begin(), cand.end());
+    for (int f : cand) ee_cand_.emplace_back(ei, f);
+  }
+}
+
+void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, double dt) {
+  bt_cand_.clear();
+  bulk_idx_.clear();
+  // Bulk particles (at x^n) near a triangle; only those inside the shells' padded box
+  // are looked up.
+  const ParticleSet* ps = bulk.particles;
+  if (!ps || ps->size() == 0 || pos_.empty()) return;
+  bulk_grid_.build(pos_, all_tris_, cell_size(radius), 0.0);
+  const Vec3d pad = Vec3d::Constant(radius);
+  std::vector<int> cand;
+  Vec3d lo = pos_[0], hi = pos_[0];
+  for (const Vec3d& q : pos_) {
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  lo.array() -= radius;
+  hi.array() += radius;
+  stamp_.assign(all_tris_.size(), -1);
+  for (std::size_t p = 0; p < ps->size(); ++p) {
+    const Vec3d x = to_d(ps->x[p]) - dt * to_d(ps->v[p]);
+    if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+    // Stamps are the particle index modulo 2^31 (distinct for neighbouring queries).
+    const int id = static_cast<int>(p & 0x7fffffff);
+    cand.clear();
+    bulk_grid_.for_each_in_box(x - pad, x + pad, [&](int t) {
+      if (stamp_[static_cast<std::size_t>(t)] == id) return;
+      stamp_[static_cast<std::size_t>(t)] = id;
+      const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
+      if (boxes_apart<1, 3>({&x}, {&pos_[T[0]], &pos_[T[1]], &pos_[T[2]]}, radius)) return;
+      if (distance_to_triangle(x, pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius) cand.push_back(t);
+    });
+    if (cand.empty()) continue;
+    std::sort(cand.begin(), cand.end());
+    bulk_idx_.push_back(static_cast<std::uint32_t>(p));
+    for (int t : cand) bt_cand_.emplace_back(static_cast<int>(bulk_idx_.size() - 1), t);
+  }
+}
+
+double ShellGuard::rate(const Pair& p) const {
+  double u = 0;
+  for (std::size_t i = p.begin; i < p.end; ++i) u += entries_[i].w * p.n.dot(v_[entries_[i].point]);
+  return u;
+}
+
+std::size_t ShellGuard::impact_zones(double tol) {
+  // Union-find over the points of the pairs still closing too fast; each zone then moves
+  // as one (the mass-weighted mean velocity, per component; a held component sets the
+  // zone's). A zone's pairs then have zero relative velocity (their weights sum to 0),
+  // which meets every target (all <= 0). Zones grow while new pairs fail, a few rounds.
+  const std::size_t n = v_.size();
+  std::vector<std::size_t> parent;
+  const auto find = [&](std::size_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  std::vector<char> in_zone;
+  std::size_t zoned = 0;
+  for (int round = 0; round < 8; ++round) {
+    bool any = false;
+    for (const Pair& p : pairs_) {
+      if (!(p.target - rate(p) > tol)) continue;
+      if (!any && parent.empty()) {
+        parent.resize(n);
+        for (std::size_t i = 0; i < n; ++i) parent[i] = i;
+        in_zone.assign(n, 0);
+      }
+      any = true;
+      const std::size_t root = find(entries_[p.begin].point);
+      for (std::size_t i = p.begin; i < p.end; ++i) {
+        in_zone[entries_[i].point] = 1;
+        const std::size_t r = find(entries_[i].point);
+        if (r != root) parent[std::max(r, root)] = std::min(r, root);
+      }
+    }
+    if (!any) break;
+    // Zone velocities, summed in point order.
+    std::vector<Vec3d> mom(n, Vec3d::Zero()), mass(n, Vec3d::Zero());
+    std::vector<Eigen::Vector3i> held(n, Eigen::Vector3i::Constant(-1));
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!in_zone[i]) continue;
+      const std::size_t r = find(i);
+      for (int a = 0; a < 3; ++a) {
+        if (inv_mass_[i][a] > 0) {
+          mom[r][a] += v_[i][a] / inv_mass_[i][a];
+          mass[r][a] += 1.0 / inv_mass_[i][a];
+        } else if (held[r][a] < 0) {
+          held[r][a] = static_cast<int>(i);
+        }
+      }
+    }
+    zoned = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!in_zone[i]) continue;
+      ++zoned;
+      const std::size_t r = find(i);
+      for (int a = 0; a < 3; ++a) {
+        if (inv_mass_[i][a] == 0) continue;  // held: keeps its prescribed value
+        if (held[r][a] >= 0)
+          v_[i][a] = v_[static_cast<std::size_t>(held[r][a])][a];
+        else if (mass[r][a] > 0)
+          v_[i][a] = mom[r][a] / mass[r][a];
+      }
+    }
+  }
+  return zoned;
+}
+
+ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBulk& bulk, double dt) {
+  ShellGuardStats st;
+  if (meshes_.empty() || !(dt > 0)) return st;
+  const std::size_t np = point_offset_.back(), nv = vertex_offset_.back();
+  // Control velocities, inverse masses and start-of-step positions.
+  v_.resize(np);
+  inv_mass_.resize(np);
+  std::vector<Vec3d> x0(np);
+  for (std::size_t s = 0; s < shells.size(); ++s) {
+    const ShellObject& sh = *shells[s].shell;
+    for (std::size_t j = 0; j < sh.size(); ++j) {
+      const std::size_t g = point_offset_[s] + j;
+      v_[g] = to_d(sh.v[j]);
+      x0[g] = to_d(sh.x[j]) - dt * v_[g];
+      const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
+      const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
+      for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
+    }
+  }
+  // Limit vertices at x^n and their velocities.
+  pos_.assign(nv, Vec3d::Zero());
+  vel_.assign(nv, Vec3d::Zero());
+  double vmax = 0;
+  for (std::size_t s = 0; s < meshes_.size(); ++s) {
+    const LimitMesh& L = *meshes_[s].limit;
+    for (std::size_t r = 0; r < L.num_vertices(); ++r) {
+      const std::size_t g = vertex_offset_[s] + r;
+      const std::vector<int>& pts = L.row_points(r);
+      const std::vector<Real>& w = L.row_weights(r);
+      for (std::size_t k = 0; k < pts.size(); ++k) {
+        const std::size_t c = point_offset_[s] + static_cast<std::size_t>(pts[k]);
+        pos_[g] += static_cast<double>(w[k]) * x0[c];
+        vel_[g] += static_cast<double>(w[k]) * v_[c];
+      }
+      vmax = std::max(vmax, vel_[g].norm());
+    }
+  }
+  ParticleSet* const ps = bulk.particles;
+  const std::size_t nb = ps ? ps->size() : 0;
+  double vbulk = 0;
+  for (std::size_t p = 0; p < nb; ++p) vbulk = std::max(vbulk, static_cast<double>(ps->v[p].norm()));
+  if (!std::isfinite(vmax) || !std::isfinite(vbulk)) return st;  // diverged: the solver says so
+  // Relative motion bounds this step: shell against shell, bulk against shell.
+  const double reach = 2.0 * vmax * dt, reach_bulk = dt * (vmax + vbulk);
+  const double r = gap_ + reach, r_bulk = gap_ + reach_bulk;
+  // Candidate lists, rebuilt when the motion since the last build could bring a pair
+  // left out within reach (a pair left out was at least gap + margin apart then), and
+  // the bulk list also when the particles were reordered or added.
+  if (!shell_list_.valid(reach)) {
+    shell_list_.start(gap_, reach);
+    build_shell_candidates(gap_ + shell_list_.margin);
+  }
+  shell_list_.moved += reach;
+  if (nb > 0 && (!bulk_list_.valid(reach_bulk) || bulk.epoch != built_epoch_ ||
+                 nb != built_count_)) {
+    bulk_list_.start(gap_, reach_bulk);
+    build_bulk_candidates(gap_ + bulk_list_.margin, bulk, dt);
+    built_epoch_ = bulk.epoch;
+    built_count_ = nb;
+  }
+  bulk_list_.moved += reach_bulk;
+  // The bulk candidates join the unknowns after the control points.
+  const std::size_t nbk = bulk_idx_.size();
+  v_.resize(np + nbk);
+  inv_mass_.resize(np + nbk);
+  bulk_x0_.resize(nbk);
+  for (std::size_t k = 0; k < nbk; ++k) {
+    const std::size_t p = bulk_idx_[k];
+    v_[np + k] = to_d(ps->v[p]);
+    bulk_x0_[k] = to_d(ps->x[p]) - dt * v_[np + k];
+    const double m = static_cast<double>(ps->volume[p]) *
+                     static_cast<double>((*bulk.densities)[ps->material[p]]);
+    inv_mass_[np + k] = Vec3d::Constant(m > 0 ? 1.0 / m : 0.0);
+  }
+
+  entries_.clear();
+  pairs_.clear();
+  const auto local = [&](std::size_t g) {
+    return static_cast<int>(g - vertex_offset_[vert_shell_[g]]);
+  };
+  const double tiny = 1e-12 * gap_;
+  // Vertex-triangle pairs.
+  for (const Eigen::Vector2i& c : vt_cand_) {
+    const std::size_t p = static_cast<std::size_t>(c[0]);
+    const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(c[1])];
+    const Vec3d &a = pos_[T[0]], &b = pos_[T[1]], &cc = pos_[T[2]];
+    if (boxes_apart<1, 3>({&pos_[p]}, {&a, &b, &cc}, r)) continue;
+    const Vec3d w = closest_point_barycentric(pos_[p], a, b, cc);
+    const Vec3d diff = pos_[p] - (w[0] * a + w[1] * b + w[2] * cc);
+    const double d = diff.norm();
+    if (!(d < r)) continue;
+    Vec3d n;
+    if (d > tiny) {
+      n = diff / d;
+    } else {
+      n = (b - a).cross(cc - a);
+      if (!(n.norm() > 0)) continue;
+      n.normalize();
+    }
+    add_vertex(vert_shell_[p], local(p), 1.0);
+    for (int k = 0; k < 3; ++k) add_vertex(vert_shell_[T[k]], local(T[k]), -w[k]);
+    add_pair(n, d, dt);
+  }
+  // Edge-edge pairs.
+  for (const Eigen::Vector2i& c : ee_cand_) {
+    const Eigen::Vector3i& E = all_edges_[static_cast<std::size_t>(c[0])];
+    const Eigen::Vector3i& F = all_edges_[static_cast<std::size_t>(c[1])];
+    const Vec3d &p0 = pos_[E[0]], &p1 = pos_[E[1]], &q0 = pos_[F[0]], &q1 = pos_[F[1]];
+    if (boxes_apart<2, 2>({&p0, &p1}, {&q0, &q1}, r)) continue;
+    const Eigen::Vector2d st2 = closest_segment_params(p0, p1, q0, q1);
+    const Vec3d diff = (p0 + st2[0] * (p1 - p0)) - (q0 + st2[1] * (q1 - q0));
+    const double d = diff.norm();
+    if (!(d < r)) continue;
+    Vec3d n;
+    if (d > tiny) {
+      n = diff / d;
+    } else {
+      n = (p1 - p0).cross(q1 - q0);
+      if (!(n.norm() > 0)) continue;
+      n.normalize();
+    }
+    const std::size_t s = vert_shell_[E[0]], s2 = vert_shell_[F[0]];
+    add_vertex(s, local(E[0]), 1.0 - st2[0]);
+    add_vertex(s, local(E[1]), st2[0]);
+    add_vertex(s2, local(F[0]), -(1.0 - st2[1]));
+    add_vertex(s2, local(F[1]), -st2[1]);
+    add_pair(n, d, dt);
+  }
+  // Bulk particle-triangle pairs.
+  for (const Eigen::Vector2i& c : bt_cand_) {
+    const std::size_t k = static_cast<std::size_t>(c[0]);
+    const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(c[1])];
+    const Vec3d &a = pos_[T[0]], &b = pos_[T[1]], &cc = pos_[T[2]];
+    if (boxes_apart<1, 3>({&bulk_x0_[k]}, {&a, &b, &cc}, r_bulk)) continue;
+    const Vec3d w = closest_point_barycentric(bulk_x0_[k], a, b, cc);
+    const Vec3d diff = bulk_x0_[k] - (w[0] * a + w[1] * b + w[2] * cc);
+    const double d = diff.norm();
+    if (!(d < r_bulk)) continue;
+    Vec3d n;
+    if (d > tiny) {
+      n = diff / d;
+    } else {
+      n = (b - a).cross(cc - a);
+      if (!(n.norm() > 0)) continue;
+      n.normalize();
+    }
+    entries_.push_back({np + k, 1.0});
+    for (int q = 0; q < 3; ++q) add_vertex(vert_shell_[T[q]], local(T[q]), -w[q]);
+    add_pair(n, d, dt);
+  }
+  st.pairs = pairs_.size();
+  if (pairs_.empty()) return st;
+
+  // Projected Gauss-Seidel on the accumulated impulses (lambda >= 0).
+  const double tol = 1e-4 * gap_ / dt;
+  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+    st.sweeps = sweep + 1;
+    double change = 0;
+    for (Pair& p : pairs_) {
+      if (!(p.denom > 0)) continue;
+      const double lam = std::max(0.0, p.lambda + (p.target - rate(p)) / p.denom);
+      const double dl = lam - p.lambda;
+      if (dl == 0) continue;
+      p.lambda = lam;
+      for (std::size_t i = p.begin; i < p.end; ++i) {
+        const Entry& en = entries_[i];
+        v_[en.point] += (en.w * dl) * p.n.cwiseProduct(inv_mass_[en.point]);
+      }
+      change = std::max(change, std::abs(dl) * p.denom);
+    }
+    if (change <= tol) break;
+  }
+  for (const Pair& p : pairs_)
+    if (p.lambda > 0) ++st.impulses;
+  st.zoned = impact_zones(tol);
+  for (const Pair& p : pairs_)
+    if (p.target - rate(p) > tol) ++st.unresolved;
+  if (st.impulses == 0 && st.zoned == 0) return st;
+  // Write back: changed velocities, and x^{n+1} = x^n + dt v moves with them.
+  for (std::size_t s = 0; s < shells.size(); ++s) {
+    ShellObject& sh = *shells[s].shell;
+    for (std::size_t j = 0; j < sh.size(); ++j) {
+      const Vec3 vn = v_[point_offset_[s] + j].cast<Real>();
+      for (int a = 0; a < 3; ++a) {
+        if (vn[a] == sh.v[j][a]) continue;
+        sh.x[j][a] += static_cast<Real>(dt) * (vn[a] - sh.v[j][a]);
+        sh.v[j][a] = vn[a];
+      }
+    }
+  }
+  for (std::size_t k = 0; k < nbk; ++k) {
+    const std::size_t p = bulk_idx_[k];
+    const Vec3 vn = v_[np + k].cast<Real>();
+    for (int a = 0; a < 3; ++a) {
+      if (vn[a] == ps->v[p][a]) continue;
+      ps->x[p][a] += static_cast<Real>(dt) * (vn[a] - ps->v[p][a]);
+      ps->v[p][a] = vn[a];
+    }
+  }
+  return st;
+}
+
+}  // namespace shellmpm

@@ -1,0 +1,156 @@
+// The shell guard: keeps contact shells from passing through each other and through
+// themselves where the grid cannot resolve them (issue 10).
+//
+// Why it exists. Grid contact (shell_fields.h, shell_contact.h) acts through node
+// velocities, so two layers closer than about a cell share nodes; in a tight twist or a
+// stack driven together, a dozen layers can sit in one cell and the surface between the
+// control points crosses without the grid seeing it, at any contact stiffness (measured
+// in the issue 10 notes). The guard works on the surface itself, like the proximity
+// impulses of Bridson, Fedkiw and Anderson 2002 ("Robust treatment of collisions,
+// contact and friction for cloth animation"): it never replaces the grid's contact and
+// friction, it only stops the last approach closer than a gap the grid would not hold.
+//
+// What it does, once per step after G2P (control points have v^{n+1} and
+// x^{n+1} = x^n + dt v^{n+1}):
+// - Geometry at the start of the step: the limit mesh at refine 0 (the Loop limit
+//   positions of the control points, the surface the integrity monitor judges), built
+//   from x^n = x^{n+1} - dt v^{n+1}; limit velocities u = S v with the same sparse map S.
+// - Bulk particles are points of the same kind: a bulk particle closer than the gap to a
+//   limit triangle is a pair like a limit vertex (its mass from volume and density).
+// - Proximity pairs at x^n within gap + reach (reach = twice the largest limit speed
+//   times dt; candidates from lists rebuilt only when the motion needs it): vertex-triangle (a limit vertex not on the triangle) and edge-edge (edges
+//   without a common vertex), between shells and within a shell. Within a shell, pairs
+//   closer than about one mesh edge at rest are left out (see Mesh::near).
+// - Each pair is a one-sided constraint on the relative limit velocity along its normal
+//   n (from the closest point of the second feature to the first): with distance d,
+//   n . (u_1 - u_2) >= -max(d - gap, 0) / dt, i.e. the pair may close up to the gap but no
+//   further within the step, and a pair already inside the gap stops closing. The
+//   constraint is linear in the control velocities (a row J of S-weights), and is met by
+//   mass-weighted impulses dv = M^-1 J^T lambda, lambda >= 0 (projected Gauss-Seidel in a
+//   fixed order, so the result does not depend on the thread count). Pinned components
+//   have zero inverse mass. The impulses are along n only (no friction: sliding stays
+//   the grid's Coulomb law), they remove approach velocity (dissipative, never adding
+//   energy) and sum to zero over the control points (S rows and barycentric weights
+//   both sum to 1), so momentum is conserved except at pins.
+// - Control points whose velocity changed move by dt (v_new - v_old), so
+//   x^{n+1} = x^n + dt v_new still holds.
+// Pairs still violated after the sweep cap go to impact zones (Provot 1997, Bridson et
+// al. 2002): the points of connected violated pairs move with their mean velocity, so
+// those pairs stop closing; momentum is kept, energy only lost. What even that cannot
+// meet (two pins driving one zone) is counted as unresolved (stats.json), and the
+// integrity monitor stays the judge of whether anything crossed.
+#pragma once
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+#include "sim/contact/shell_transfer.h"
+#include "sim/math/triangle_queries.h"
+#include "sim/mpm/particles.h"
+#include "sim/shell/limit_mesh.h"
+
+namespace shellmpm {
+
+/// The bulk particles a guard pass also keeps out of the shells (particles may be null).
+struct GuardBulk {
+  ParticleSet* particles = nullptr;
+  const std::vector<Real>* densities = nullptr;  ///< per material [kg/m^3]
+  std::uint64_t epoch = 0;  ///< changes whenever the particles are reordered
+};
+
+/// What one guard pass did.
+struct ShellGuardStats {
+  std::size_t pairs = 0;       ///< proximity pairs within gap + reach
+  std::size_t impulses = 0;    ///< pairs that needed an impulse
+  std::size_t zoned = 0;       ///< points moved as rigid impact zones (Gauss-Seidel fell short)
+  std::size_t unresolved = 0;  ///< pairs still closing faster than allowed at the end
+  int sweeps = 0;              ///< Gauss-Seidel sweeps taken
+};
+
+class ShellGuard {
+ public:
+  /// The shells' topology is fixed from here on. gap [m] > 0.
+  void setup(const std::vector<GridShell>& shells, double gap);
+  double gap() const { return gap_; }
+  /// One pass after G2P (see the file comment): changes v and x of control points.
+  ShellGuardStats apply(std::vector<GridShell>& shells, const GuardBulk& bulk, double dt);
+
+  /// Gauss-Seidel sweeps at most per pass.
+  static constexpr int kMaxSweeps = 100;
+
+ private:
+  struct Mesh {
+    std::unique_ptr<LimitMesh> limit;
+    std::vector<Eigen::Vector2i> edges;  ///< unique limit-mesh edges
+    std::vector<Vec3d> rest;             ///< limit vertices at rest
+    /// Pairs of this shell closer than this at rest are never paired: the larger of
+    /// 2 gap and the mean rest edge (neighbours within about one edge; the bending
+    /// stiffness, not contact, keeps a fold that tight from crossing).
+    double near = 0;
+  };
+  struct Entry {
+    std::size_t point;  ///< control point, numbered across shells
+    double w;           ///< weight in the constraint row
+  };
+  struct Pair {
+    std::size_t begin, end;  ///< its entries in entries_
+    Vec3d n;                 ///< unit normal, from the second feature to the first
+    double target;           ///< lower bound on n . (u_1 - u_2) [m/s]
+    double denom;            ///< J M^-1 J^T
+    double lambda = 0;       ///< accumulated impulse [kg m/s]
+  };
+  /// Limit vertex v of shell s as entries with weight scale.
+  void add_vertex(std::size_t s, int v, double scale);
+  void add_pair(const Vec3d& n, double d, double dt);
+  /// n . (relative velocity) of a pair at the current v_.
+  double rate(const Pair& p) const;
+  /// Moves the points of pairs still violated as rigid zones; returns how many points.
+  std::size_t impact_zones(double tol);
+  /// Vertex-triangle and edge-edge pairs closer than radius at pos_ (sorted).
+  void build_shell_candidates(double radius);
+  /// Bulk particle-triangle pairs closer than radius (particles at x^n, sorted).
+  void build_bulk_candidates(double radius, const GuardBulk& bulk, double dt);
+  double cell_size(double radius) const;
+  /// A Verlet list's schedule: valid while the motion bound since its build stays
+  /// within its margin.
+  struct ListSchedule {
+    bool built = false;
+    double margin = 0, moved = 0;
+    bool valid(double reach) const { return built && moved + reach <= margin; }
+    void start(double gap, double reach) {
+      built = true;
+      margin = std::max(4.0 * gap, 4.0 * reach);
+      moved = 0;
+    }
+  };
+
+  double gap_ = 0;
+  std::vector<Mesh> meshes_;
+  std::vector<std::size_t> point_offset_;   ///< first control point of each shell
+  std::vector<std::size_t> vertex_offset_;  ///< first limit vertex of each shell
+  std::vector<std::size_t> vert_shell_;     ///< shell of each limit vertex
+  // Candidate pairs (Verlet lists): built within gap + margin, valid until the relative
+  // motion bound since then could close the margin. Which pairs are candidates
+  // never changes a result: a pass acts on the pairs within gap + reach, all of which
+  // are candidates, in candidate order (vertex, triangle; then edge, edge).
+  std::vector<Eigen::Vector2i> vt_cand_, ee_cand_;
+  std::vector<Eigen::Vector2i> bt_cand_;  ///< (index into bulk_idx_, triangle)
+  std::vector<std::uint32_t> bulk_idx_;   ///< bulk particles with a candidate, ascending
+  std::vector<Vec3d> bulk_x0_;            ///< their positions at x^n (per pass)
+  std::uint64_t built_epoch_ = 0;
+  std::size_t built_count_ = 0;
+  ListSchedule shell_list_, bulk_list_;
+  // Per pass (kept to reuse their memory).
+  std::vector<Vec3d> pos_, vel_;         ///< limit vertices of all shells at x^n, their u
+  std::vector<Vec3d> v_;                 ///< control velocities (double) being corrected
+  std::vector<Vec3d> inv_mass_;          ///< per control point and component
+  std::vector<Eigen::Vector3i> all_tris_;
+  std::vector<Vec3d> edge_tri_pos_;
+  std::vector<Eigen::Vector3i> all_edges_;  ///< edges as degenerate triangles (a, b, b)
+  TriangleGrid tri_grid_, edge_grid_, bulk_grid_;  ///< used by the list builds only
+  std::vector<int> stamp_;  ///< last query that saw each feature (list builds)
+  std::vector<Entry> entries_;
+  std::vector<Pair> pairs_;
+};
+
+}  // namespace shellmpm

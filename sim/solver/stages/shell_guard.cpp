@@ -1,0 +1,43 @@
+#include "sim/solver/stages/shell_guard.h"
+
+#include <algorithm>
+
+#include "sim/solver/stages/scene_rules.h"
+
+namespace shellmpm {
+
+bool ShellGuardStage::needed(const Scene& s) {
+  return s.shot.shell_guard && any_contact_shell(s);
+}
+
+double ShellGuardStage::gap(const Scene& s) {
+  if (s.shot.shell_guard_gap > 0) return s.shot.shell_guard_gap;
+  double g = 0.05 * s.shot.dx;
+  for (std::size_t i = 0; i < s.shells.size(); ++i) {
+    if (!shell_has_contact(s, i)) continue;
+    g = std::max(g, s.shell_materials[static_cast<std::size_t>(s.shells[i].material)].thickness);
+  }
+  return g;
+}
+
+void ShellGuardStage::run(StepContext& c) {
+  if (!ready_) {
+    guard_.setup(c.grid_shells, gap(c.scene));
+    ready_ = true;
+  }
+  GuardBulk bulk;
+  if (c.particles.size() > 0) {
+    bulk.particles = &c.particles;
+    bulk.densities = &c.densities;
+    bulk.epoch = c.particle_epoch;
+  }
+  const ShellGuardStats st = guard_.apply(c.grid_shells, bulk, c.dt);
+  ShellGuardStats& f = c.guard_frame;
+  f.pairs = std::max(f.pairs, st.pairs);
+  f.impulses += st.impulses;
+  f.zoned += st.zoned;
+  f.unresolved += st.unresolved;
+  f.sweeps = std::max(f.sweeps, st.sweeps);
+}
+
+}  // namespace shellmpm
