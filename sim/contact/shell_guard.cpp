@@ -313,39 +313,11 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
   ShellGuardStats st;
   if (meshes_.empty() || !(dt > 0)) return st;
   const std::size_t np = point_offset_.back(), nv = vertex_offset_.back();
-  // Control velocities, inverse masses and start-of-step positions.
-  v_.resize(np);
-  inv_mass_.resize(np);
-  std::vector<Vec3d> x0(np);
-  for (std::size_t s = 0; s < shells.size(); ++s) {
-    const ShellObject& sh = *shells[s].shell;
-    for (std::size_t j = 0; j < sh.size(); ++j) {
-      const std::size_t g = point_offset_[s] + j;
-      v_[g] = to_d(sh.v[j]);
-      x0[g] = to_d(sh.x[j]) - dt * v_[g];
-      const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
-      const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
-      for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
-    }
-  }
-  // Limit vertices at x^n and their velocities.
-  pos_.assign(nv, Vec3d::Zero());
-  vel_.assign(nv, Vec3d::Zero());
+  // Speed bounds: the limit vertices are convex combinations of the control points (Loop
+  // limit weights are positive), so the largest control-point speed bounds theirs.
   double vmax = 0;
-  for (std::size_t s = 0; s < meshes_.size(); ++s) {
-    const LimitMesh& L = *meshes_[s].limit;
-    for (std::size_t r = 0; r < L.num_vertices(); ++r) {
-      const std::size_t g = vertex_offset_[s] + r;
-      const std::vector<int>& pts = L.row_points(r);
-      const std::vector<Real>& w = L.row_weights(r);
-      for (std::size_t k = 0; k < pts.size(); ++k) {
-        const std::size_t c = point_offset_[s] + static_cast<std::size_t>(pts[k]);
-        pos_[g] += static_cast<double>(w[k]) * x0[c];
-        vel_[g] += static_cast<double>(w[k]) * v_[c];
-      }
-      vmax = std::max(vmax, vel_[g].norm());
-    }
-  }
+  for (const GridShell& g : shells)
+    for (const Vec3& v : g.shell->v) vmax = std::max(vmax, static_cast<double>(v.norm()));
   ParticleSet* const ps = bulk.particles;
   const std::size_t nb = ps ? ps->size() : 0;
   double vbulk = 0;
@@ -357,19 +329,52 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
   // Candidate lists, rebuilt when the motion since the last build could bring a pair
   // left out within reach (a pair left out was at least gap + margin apart then), and
   // the bulk list also when the particles were reordered or added.
-  if (!shell_list_.valid(reach)) {
+  const bool shell_rebuild = !shell_list_.valid(reach);
+  const bool bulk_rebuild = nb > 0 && (!bulk_list_.valid(reach_bulk) ||
+                                       bulk.epoch != built_epoch_ || nb != built_count_);
+  if (nb == 0) bt_cand_.clear(), bulk_idx_.clear();
+  shell_list_.moved += reach;
+  bulk_list_.moved += reach_bulk;
+  if (!shell_rebuild && !bulk_rebuild && vt_cand_.empty() && ee_cand_.empty() &&
+      bt_cand_.empty())
+    return st;  // nothing near, and the lists still hold
+  // Control velocities, inverse masses and start-of-step positions.
+  v_.resize(np);
+  inv_mass_.resize(np);
+  x0_.resize(np);
+  for (std::size_t s = 0; s < shells.size(); ++s) {
+    const ShellObject& sh = *shells[s].shell;
+    for (std::size_t j = 0; j < sh.size(); ++j) {
+      const std::size_t g = point_offset_[s] + j;
+      v_[g] = to_d(sh.v[j]);
+      x0_[g] = to_d(sh.x[j]) - dt * v_[g];
+      const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
+      const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
+      for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
+    }
+  }
+  // Limit vertices at x^n.
+  pos_.assign(nv, Vec3d::Zero());
+  for (std::size_t s = 0; s < meshes_.size(); ++s) {
+    const LimitMesh& L = *meshes_[s].limit;
+    for (std::size_t row = 0; row < L.num_vertices(); ++row) {
+      const std::size_t g = vertex_offset_[s] + row;
+      const std::vector<int>& pts = L.row_points(row);
+      const std::vector<Real>& w = L.row_weights(row);
+      for (std::size_t k = 0; k < pts.size(); ++k)
+        pos_[g] += static_cast<double>(w[k]) * x0_[point_offset_[s] + static_cast<std::size_t>(pts[k])];
+    }
+  }
+  if (shell_rebuild) {
     shell_list_.start(gap_, reach);
     build_shell_candidates(gap_ + shell_list_.margin);
   }
-  shell_list_.moved += reach;
-  if (nb > 0 && (!bulk_list_.valid(reach_bulk) || bulk.epoch != built_epoch_ ||
-                 nb != built_count_)) {
+  if (bulk_rebuild) {
     bulk_list_.start(gap_, reach_bulk);
     build_bulk_candidates(gap_ + bulk_list_.margin, bulk, dt);
     built_epoch_ = bulk.epoch;
     built_count_ = nb;
   }
-  bulk_list_.moved += reach_bulk;
   // The bulk candidates join the unknowns after the control points.
   const std::size_t nbk = bulk_idx_.size();
   v_.resize(np + nbk);

@@ -120,7 +120,7 @@ class ShellGuard {
     void start(double gap, double reach) {
       built = true;
       margin = std::max(4.0 * gap, 4.0 * reach);
-      moved = 0;
+      moved = reach;  // this step's motion counts
     }
   };
 
@@ -141,7 +141,8 @@ class ShellGuard {
   std::size_t built_count_ = 0;
   ListSchedule shell_list_, bulk_list_;
   // Per pass (kept to reuse their memory).
-  std::vector<Vec3d> pos_, vel_;         ///< limit vertices of all shells at x^n, their u
+  std::vector<Vec3d> pos_;               ///< limit vertices of all shells at x^n
+  std::vector<Vec3d> x0_;                ///< control points at x^n
   std::vector<Vec3d> v_;                 ///< control velocities (double) being corrected
   std::vector<Vec3d> inv_mass_;          ///< per control point and component
   std::vector<Eigen::Vector3i> all_tris_;
