@@ -23,6 +23,7 @@
 #include <utility>
 
 #include "io/utf8.h"
+#include "io/yaml_key_near.h"
 #include "sim/collider/shape_sdf.h"
 #include "sim/core/check.h"
 
@@ -677,7 +678,14 @@ YAML::Node load_yaml(const std::string& text, const std::string& where, const st
     docs = YAML::LoadAll(text);
   } catch (const YAML::Exception& e) {
     const int line = from_file && e.mark.line >= 0 ? e.mark.line + 1 : 0;
-    throw UserError(where, line, key, "YAML syntax error: " + e.msg);
+    if (!from_file || line == 0) throw UserError(where, line, key, "YAML syntax error: " + e.msg);
+    // The text does not parse, so the key comes from indentation (io/yaml_key_near.h).
+    const std::string near = yaml_key_near_line(text, line);
+    throw UserError(where, line, "",
+                    "YAML syntax error" +
+                        (near.empty() ? std::string(" (before the first key)")
+                                      : " in or after key " + near) +
+                        ": " + e.msg);
   }
   if (docs.size() > 1) {
     throw UserError(where, 0, key,

@@ -33,9 +33,10 @@ struct CmdResult {
   std::string output;  ///< stdout and stderr together
 };
 
-/// Runs `shellmpm ARGS` through the shell, capturing output and the exit code.
-inline CmdResult run_shellmpm(const std::string& args) {
-  const std::string cmd = std::string(SHELLMPM_BINARY) + " " + args + " 2>&1";
+/// Runs `PREFIX shellmpm ARGS` through the shell (PREFIX: e.g. "timeout 10 "), capturing
+/// output and the exit code.
+inline CmdResult run_shellmpm_prefixed(const std::string& prefix, const std::string& args) {
+  const std::string cmd = prefix + std::string(SHELLMPM_BINARY) + " " + args + " 2>&1";
   CmdResult r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -46,6 +47,9 @@ inline CmdResult run_shellmpm(const std::string& args) {
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+/// Runs `shellmpm ARGS` through the shell, capturing output and the exit code.
+inline CmdResult run_shellmpm(const std::string& args) { return run_shellmpm_prefixed("", args); }
 
 inline std::string read_text(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
