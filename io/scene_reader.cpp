@@ -649,7 +649,8 @@ DocNode convert(const YAML::Node& n, const std::string& where, bool from_file, i
         if (!it->first.IsScalar()) {
           fail(ko, path,
                "mapping keys must be plain words, got a " +
-                   std::string(it->first.IsNull() ? "null" : "list or mapping") + " as a key");
+                   std::string(it->first.IsNull() ? "null" : "list or mapping") + " as a key" +
+                   (path.empty() ? " at the top level" : ""));
         }
         const std::string key = it->first.Scalar();
         const std::string key_path = join_key(path, key);

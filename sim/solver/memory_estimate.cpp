@@ -252,6 +252,7 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   // Shells.
   double shells_persistent = 0, construction = 0, grid_points = 0, force_scratch = 0;
   double fields_bytes = 0, contact_bytes = 0, integrity_bytes = 0, shell_bytes = 0;
+  double guard_bytes = 0;
   std::size_t grid_shells = 0;
   const bool fields_wanted = !shot.shared_shell_velocity;
   std::vector<double> shell_pblocks;
@@ -297,6 +298,13 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
                      V * (kMat3 + 4);
     // The integrity monitor's own limit mesh (level 0), edges, rim distances, positions.
     integrity_bytes += limit_mesh_bytes(V, T, S, false) + V * (8 + 48 + 3) + 1.5 * T * 8;
+    // The shell guard (sim/contact/shell_guard.h): its own limit mesh, edges (1.5 T), rest
+    // positions; per pass the control and limit positions, velocities and inverse masses
+    // (double); the triangle and edge grids of a list build, each feature in about 4 cells
+    // (a sorted (key, feature) pair plus the kept key and feature), and the stamps.
+    if (shot.shell_guard)
+      guard_bytes += limit_mesh_bytes(V, T, S, false) + 1.5 * T * 8 + V * (24 + 8) +
+                     V * 4 * 24 + 2.5 * T * 4 * (16 + 12) + 2.5 * T * 4;
     // Shell table, binned positions, pin holds and the force buffer of the grid shell.
     grid_points += V;
     shell_bytes += V * (2 + 4 + kVec3 + 1 + kVec3);
@@ -334,7 +342,8 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
                {"shells", shell_bytes},
                {"contact", contact_bytes},
                {"per-shell fields", fields_bytes},
-               {"integrity", integrity_bytes}};
+               {"integrity", integrity_bytes},
+               {"shell guard", guard_bytes}};
   double held = 0;
   for (const MemoryPart& p : out.parts) held += p.bytes;
   // A step: the adjoints of the largest shell's forces; an emitting run also copies one

@@ -7,6 +7,7 @@
 //   "error: FILE:LINE: KEY: message"                           (a value or key)
 //   "error: FILE:LINE: YAML syntax error in or after key KEY: ..." (text that does not parse)
 //   "error: FILE:LINE: YAML syntax error (before the first key): ..."
+//   "error: FILE:LINE: ... at the top level" (a top-level entry that is not a key)
 // and the whole-file forms listed in kFileLevel (the key cannot be known: the file is
 // not UTF-8, is several documents, or a mesh/asset it names is broken).
 //
@@ -191,11 +192,14 @@ std::string message_problem(const std::string& out, const std::string& file) {
   const std::string rest = m[3].str();
   for (const std::string& f : kFileLevel)
     if (rest.find(f) == 0) return "";
-  // A key path from a top-level key (a misspelt key is named as written).
-  static const std::regex keyed(
-      R"(^(version|shot|materials|sources|colliders|shell_materials|shells|preroll|output|render)([.\[:].*)?: .*)");
+  // A key path (a misspelt key is named as written, e.g. "shot.dom[ain").
+  static const std::regex keyed(R"(^[A-Za-z_"'][^ ]*: .*)");
   if (std::regex_match(rest, keyed)) return "";
-  if (rest.find(": unknown key '") != std::string::npos) return "";
+  // A misspelt key with spaces in it, named as written.
+  if (rest.find(": unknown key '") != std::string::npos ||
+      rest.find(": duplicate key '") != std::string::npos)
+    return "";
+  if (rest.find(" at the top level") != std::string::npos) return "";  // no key to name
   return "names no key: " + line;
 }
 
