@@ -240,6 +240,24 @@ void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, dou
   }
 }
 
+bool ShellGuard::point_triangle_pair(const Vec3d& x, const Eigen::Vector3i& T, double r,
+                                     double tiny, Vec3d& w, double& d, Vec3d& n) const {
+  const Vec3d &a = pos_[T[0]], &b = pos_[T[1]], &c = pos_[T[2]];
+  if (boxes_apart<1, 3>({&x}, {&a, &b, &c}, r)) return false;
+  w = closest_point_barycentric(x, a, b, c);
+  const Vec3d diff = x - (w[0] * a + w[1] * b + w[2] * c);
+  d = diff.norm();
+  if (!(d < r)) return false;
+  if (d > tiny) {
+    n = diff / d;
+    return true;
+  }
+  n = (b - a).cross(c - a);  // on the triangle: its own normal
+  if (!(n.norm() > 0)) return false;
+  n.normalize();
+  return true;
+}
+
 double ShellGuard::rate(const Pair& p) const {
   double u = 0;
   for (std::size_t i = p.begin; i < p.end; ++i) u += entries_[i].w * p.n.dot(v_[entries_[i].point]);
@@ -399,20 +417,9 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
   for (const Eigen::Vector2i& c : vt_cand_) {
     const std::size_t p = static_cast<std::size_t>(c[0]);
     const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(c[1])];
-    const Vec3d &a = pos_[T[0]], &b = pos_[T[1]], &cc = pos_[T[2]];
-    if (boxes_apart<1, 3>({&pos_[p]}, {&a, &b, &cc}, r)) continue;
-    const Vec3d w = closest_point_barycentric(pos_[p], a, b, cc);
-    const Vec3d diff = pos_[p] - (w[0] * a + w[1] * b + w[2] * cc);
-    const double d = diff.norm();
-    if (!(d < r)) continue;
-    Vec3d n;
-    if (d > tiny) {
-      n = diff / d;
-    } else {
-      n = (b - a).cross(cc - a);
-      if (!(n.norm() > 0)) continue;
-      n.normalize();
-    }
+    Vec3d w, n;
+    double d;
+    if (!point_triangle_pair(pos_[p], T, r, tiny, w, d, n)) continue;
     add_vertex(vert_shell_[p], local(p), 1.0);
     for (int k = 0; k < 3; ++k) add_vertex(vert_shell_[T[k]], local(T[k]), -w[k]);
     add_pair(n, d, dt);
@@ -446,20 +453,9 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
   for (const Eigen::Vector2i& c : bt_cand_) {
     const std::size_t k = static_cast<std::size_t>(c[0]);
     const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(c[1])];
-    const Vec3d &a = pos_[T[0]], &b = pos_[T[1]], &cc = pos_[T[2]];
-    if (boxes_apart<1, 3>({&bulk_x0_[k]}, {&a, &b, &cc}, r_bulk)) continue;
-    const Vec3d w = closest_point_barycentric(bulk_x0_[k], a, b, cc);
-    const Vec3d diff = bulk_x0_[k] - (w[0] * a + w[1] * b + w[2] * cc);
-    const double d = diff.norm();
-    if (!(d < r_bulk)) continue;
-    Vec3d n;
-    if (d > tiny) {
-      n = diff / d;
-    } else {
-      n = (b - a).cross(cc - a);
-      if (!(n.norm() > 0)) continue;
-      n.normalize();
-    }
+    Vec3d w, n;
+    double d;
+    if (!point_triangle_pair(bulk_x0_[k], T, r_bulk, tiny, w, d, n)) continue;
     entries_.push_back({np + k, 1.0});
     for (int q = 0; q < 3; ++q) add_vertex(vert_shell_[T[q]], local(T[q]), -w[q]);
     add_pair(n, d, dt);

@@ -102,6 +102,11 @@ class ShellGuard {
   /// Limit vertex v of shell s as entries with weight scale.
   void add_vertex(std::size_t s, int v, double scale);
   void add_pair(const Vec3d& n, double d, double dt);
+  /// Point x against limit triangle T (at pos_): closer than r? Then the closest point's
+  /// barycentric weights w, the distance d and the pair's unit normal n (from the
+  /// triangle to x; the triangle's own normal when x is within `tiny` of it).
+  bool point_triangle_pair(const Vec3d& x, const Eigen::Vector3i& T, double r, double tiny,
+                           Vec3d& w, double& d, Vec3d& n) const;
   /// n . (relative velocity) of a pair at the current v_.
   double rate(const Pair& p) const;
   /// Moves the points of pairs still violated as rigid zones; returns how many points.
