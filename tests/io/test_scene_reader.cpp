@@ -967,7 +967,7 @@ TEST_CASE("bad shell scenes name the file, line and key", "[scene][shell]") {
 }
 
 TEST_CASE(
-    "output.shell_pattern's default extension follows shell_format; a contradicting "
+    "output.shell_pattern's default extension follows shell_format, a contradicting "
     "one is refused",
     "[scene]") {
   for (const std::string fmt : {"ply", "obj", "glb"}) {

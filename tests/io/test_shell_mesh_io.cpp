@@ -246,7 +246,7 @@ std::vector<float> glb_floats(const std::string& bytes, const nlohmann::json& j,
 
 }  // namespace
 
-TEST_CASE("PLY and GLB carry per-vertex velocities in vertex order; none when not given",
+TEST_CASE("PLY and GLB carry per-vertex velocities in vertex order, none when not given",
           "[shellmesh][velocity]") {
   TempDir dir("shellmesh_velocity");
   const Grid g(5, 4);
