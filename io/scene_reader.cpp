@@ -360,9 +360,9 @@ std::vector<KeySpec> build_schema() {
       Spec("output.stats", T::String).def("stats.json").nonempty().rule(kOutputFile),
       Spec("output.checkpoint_every", T::Int).def("0").ge(0),
       Spec("output.shell_pattern", T::String)
-          .def("\"{name}.####.ply\"")
+          .optional("`\"{name}.####.ply\"`, `.obj` or `.glb` as `shell_format` says")
           .rule(std::string("exactly one run of `#`; contains `{name}` when there are several "
-                            "shells; ") +
+                            "shells; ends in `.ply`, `.obj` or `.glb` as `shell_format` says; ") +
                 kOutputFile),
       Spec("output.shell_format", T::Enum).def("ply").choices({"ply", "obj", "glb"}),
       // render (previews; nothing here changes the simulation)
@@ -2158,7 +2158,24 @@ Scene build_scene(const DocNode& root, const std::string& path) {
     o.stats_file = r.string("stats");
     require_output_file(o.stats_file, false, r.origin_of("stats"), r.path_of("stats"));
     o.checkpoint_every = r.int32("checkpoint_every");
-    o.shell_pattern = r.string("shell_pattern");
+    // The format first: the default pattern's extension follows it, and a given pattern
+    // must not name another format (a glTF file called .ply misleads every importer).
+    o.shell_format = r.choice("shell_format");
+    const std::string ext = std::string(".") + o.shell_format;
+    if (r.has("shell_pattern")) {
+      o.shell_pattern = r.string("shell_pattern");
+      const bool ends_in_ext =
+          o.shell_pattern.size() >= ext.size() &&
+          o.shell_pattern.compare(o.shell_pattern.size() - ext.size(), ext.size(), ext) == 0;
+      if (!ends_in_ext) {
+        fail(r.origin_of("shell_pattern"), r.path_of("shell_pattern"),
+             "must end in '" + ext + "' for output.shell_format " + o.shell_format + ", got '" +
+                 o.shell_pattern + "' (leave shell_pattern out for \"{name}.####" + ext +
+                 "\", or set shell_format to match)");
+      }
+    } else {
+      o.shell_pattern = "{name}.####" + ext;
+    }
     require_one_hash_run(o.shell_pattern, r.origin_of("shell_pattern"), r.path_of("shell_pattern"));
     require_output_file(o.shell_pattern, true, r.origin_of("shell_pattern"),
                         r.path_of("shell_pattern"));
@@ -2167,7 +2184,6 @@ Scene build_scene(const DocNode& root, const std::string& path) {
            "must contain {name} (the shell's name) when there is more than one shell (there are " +
                std::to_string(scene.shells.size()) + "), got '" + o.shell_pattern + "'");
     }
-    o.shell_format = r.choice("shell_format");
     r.finish();
   }
   read_render(*top.block("render"), scene.render);

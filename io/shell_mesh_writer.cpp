@@ -43,6 +43,7 @@ struct Attributes {
   std::vector<float> positions;       // 3 per vertex
   std::vector<float> normals;         // 3 per vertex, unit length (or zero)
   std::vector<float> uvs;             // 2 per vertex (origin bottom-left), empty if none
+  std::vector<float> velocities;      // 3 per vertex [m/s], empty if none
   std::vector<std::int32_t> indices;  // 3 per triangle
 };
 
@@ -87,6 +88,11 @@ Attributes gather(const MeshFrame& m) {
     for (std::size_t v = 0; v < n; ++v)
       for (int k = 0; k < 2; ++k) a.uvs[2 * v + k] = static_cast<float>(m.uvs[v][k]);
   }
+  if (m.velocities) {
+    a.velocities.resize(3 * n);
+    for (std::size_t v = 0; v < n; ++v)
+      for (int k = 0; k < 3; ++k) a.velocities[3 * v + k] = static_cast<float>(m.velocities[v][k]);
+  }
   return a;
 }
 
@@ -125,7 +131,7 @@ std::string single_token(const std::string& name) {
 
 std::string encode_ply(const MeshFrame& m, const Attributes& a) {
   const std::size_t n = m.num_vertices, nt = m.num_triangles;
-  const bool uv = !a.uvs.empty();
+  const bool uv = !a.uvs.empty(), vel = !a.velocities.empty();
   std::string header = "ply\nformat binary_little_endian 1.0\ncomment shellmpm shell mesh\n";
   if (!m.name.empty()) header += "comment name " + single_token(m.name) + "\n";
   header += "comment frame " + std::to_string(m.frame) + "\n";
@@ -134,10 +140,11 @@ std::string encode_ply(const MeshFrame& m, const Attributes& a) {
   header += "property float x\nproperty float y\nproperty float z\n";
   header += "property float nx\nproperty float ny\nproperty float nz\n";
   if (uv) header += "property float s\nproperty float t\n";
+  if (vel) header += "property float vx\nproperty float vy\nproperty float vz\n";
   header += "element face " + std::to_string(nt) + "\n";
   header += "property list uchar int vertex_indices\nend_header\n";
 
-  const std::size_t stride = uv ? 8 : 6;
+  const std::size_t stride = 6 + (uv ? 2 : 0) + (vel ? 3 : 0);
   std::string out;
   out.reserve(header.size() + n * stride * 4 + nt * 13);
   out += header;
@@ -147,6 +154,7 @@ std::string encode_ply(const MeshFrame& m, const Attributes& a) {
     std::memcpy(r, &a.positions[3 * v], 3 * sizeof(float));
     std::memcpy(r + 3, &a.normals[3 * v], 3 * sizeof(float));
     if (uv) std::memcpy(r + 6, &a.uvs[2 * v], 2 * sizeof(float));
+    if (vel) std::memcpy(r + (uv ? 8 : 6), &a.velocities[3 * v], 3 * sizeof(float));
   }
   append_raw(out, record.data(), record.size());
   std::string faces(nt * 13, '\0');
@@ -227,11 +235,12 @@ std::string json_float(float x) {
 
 std::string encode_glb(const MeshFrame& m, const Attributes& a) {
   const std::size_t n = m.num_vertices, nt = m.num_triangles;
-  const bool uv = !a.uvs.empty();
+  const bool uv = !a.uvs.empty(), vel = !a.velocities.empty();
 
-  // BIN chunk: positions, normals, [uvs], indices; every block is a multiple of 4 bytes.
+  // BIN chunk: positions, normals, [uvs], [velocities], indices; every block is a
+  // multiple of 4 bytes.
   std::string bin;
-  bin.reserve(n * (uv ? 32 : 24) + nt * 12);
+  bin.reserve(n * (24 + (uv ? 8 : 0) + (vel ? 12 : 0)) + nt * 12);
   append_raw(bin, a.positions.data(), a.positions.size());
   append_raw(bin, a.normals.data(), a.normals.size());
   if (uv) {
@@ -239,6 +248,7 @@ std::string encode_glb(const MeshFrame& m, const Attributes& a) {
     for (std::size_t v = 0; v < n; ++v) flipped[2 * v + 1] = 1.0f - flipped[2 * v + 1];
     append_raw(bin, flipped.data(), flipped.size());
   }
+  if (vel) append_raw(bin, a.velocities.data(), a.velocities.size());
   const std::size_t index_offset = bin.size();
   append_raw(bin, a.indices.data(), a.indices.size());
 
@@ -256,9 +266,12 @@ std::string encode_glb(const MeshFrame& m, const Attributes& a) {
        ",\"time\":" + format_double(m.time) + "}}],";
   j += "\"nodes\":[{\"name\":" + name + ",\"mesh\":0}],";
   j += "\"meshes\":[{\"name\":" + name + ",\"primitives\":[{\"attributes\":{";
+  // Accessors in BIN order: POSITION, NORMAL, [TEXCOORD_0], [_VELOCITY], indices.
+  int accessor = 2;
   j += "\"POSITION\":0,\"NORMAL\":1";
-  if (uv) j += ",\"TEXCOORD_0\":2";
-  j += "},\"indices\":" + std::to_string(uv ? 3 : 2) + ",\"mode\":4}]}],";
+  if (uv) j += ",\"TEXCOORD_0\":" + std::to_string(accessor++);
+  if (vel) j += ",\"_VELOCITY\":" + std::to_string(accessor++);
+  j += "},\"indices\":" + std::to_string(accessor) + ",\"mode\":4}]}],";
   j += "\"buffers\":[{\"byteLength\":" + std::to_string(bin.size()) + "}],";
   // bufferViews and accessors, one per attribute, in the BIN order above.
   std::string views = "\"bufferViews\":[", accessors = "\"accessors\":[";
@@ -287,6 +300,7 @@ std::string encode_glb(const MeshFrame& m, const Attributes& a) {
   add(12 * n, kArrayBuffer, kFloat, n, "VEC3", minmax);
   add(12 * n, kArrayBuffer, kFloat, n, "VEC3", "");
   if (uv) add(8 * n, kArrayBuffer, kFloat, n, "VEC2", "");
+  if (vel) add(12 * n, kArrayBuffer, kFloat, n, "VEC3", "");
   SHELLMPM_CHECK(offset == index_offset, "offset " << offset << " vs " << index_offset);
   add(12 * nt, kElementArrayBuffer, kUnsignedInt, 3 * nt, "SCALAR", "");
   j += views + "]," + accessors + "]}";

@@ -8,12 +8,17 @@
 // enforces aiProcess_JoinIdenticalVertices, which merges coincident vertices and
 // reorders them; only "plyb" keeps the order, but copying the scene costs time.
 // The writers below emit exactly `num_vertices` vertices in the given order:
-//   - Ply: binary little-endian PLY. vertex: float x y z nx ny nz [s t];
+//   - Ply: binary little-endian PLY. vertex: float x y z nx ny nz [s t] [vx vy vz];
 //     face: list uchar int vertex_indices. Comments carry name, frame and time.
+//     Velocities use the particle cache's names (io/particle_cache.h): PLY properties
+//     are scalars (Blender 4.1+ imports each extra one as a float attribute); a
+//     wrangle joins them into Houdini's vector `v` (v@v = set(f@vx, f@vy, f@vz)).
 //   - Obj: "v x y z", "vn", "vt" lines, one of each per vertex, so every face
 //     corner is "i/i/i" (or "i//i" without UVs); shortest round-trip float text.
+//     OBJ has no per-vertex attributes: velocities are not written.
 //   - Glb: glTF 2.0 binary, one mesh with one triangle primitive: POSITION, NORMAL,
-//     TEXCOORD_0 (float) and UNSIGNED_INT indices. glTF puts the UV origin at the
+//     TEXCOORD_0, _VELOCITY (float; the last an application-specific attribute, glTF
+//     2.0 section 3.7.2.1) and UNSIGNED_INT indices. glTF puts the UV origin at the
 //     top-left, so TEXCOORD_0 = (u, 1 - v) (assimp and Blender flip it back).
 //     Frame and time are in the scene's "extras".
 // Every format stores 32-bit floats (also in a SHELLMPM_DOUBLE build).
@@ -43,7 +48,10 @@ struct MeshFrame {
   /// num_vertices normals, or null: then area-weighted vertex normals are computed
   /// from the triangles (a vertex on no triangle gets (0, 0, 0)). Written normalized.
   const Vec3* normals = nullptr;
-  const Eigen::Vector2d* uvs = nullptr;        ///< num_vertices UVs (origin bottom-left), or null
+  const Eigen::Vector2d* uvs = nullptr;  ///< num_vertices UVs (origin bottom-left), or null
+  /// num_vertices velocities [m/s], or null (none written). PLY vx vy vz, GLB _VELOCITY;
+  /// OBJ ignores them.
+  const Vec3* velocities = nullptr;
   const Eigen::Vector3i* triangles = nullptr;  ///< counter-clockwise seen from +normal
   std::size_t num_triangles = 0;
   int frame = 0;      ///< frame number, recorded in the file

@@ -35,7 +35,7 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
   if (o.particles && !scene.sources.empty())
     write_particle_ply(frame_path(o.directory, o.particles_pattern, frame), p);
   const MeshFormat format = parse_mesh_format(o.shell_format);
-  std::vector<Vec3> pos, nrm;
+  std::vector<Vec3> pos, nrm, vel;
   for (const auto& sh : solver.shells()) {
     if (!sh->desc().write_mesh) continue;
     sh->output_mesh(pos, nrm);
@@ -45,6 +45,10 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
     mf.num_vertices = pos.size();
     mf.normals = nrm.data();
     mf.uvs = lm.uvs().empty() ? nullptr : lm.uvs().data();
+    if (o.velocity) {
+      sh->output_velocity(vel);
+      mf.velocities = vel.data();
+    }
     mf.triangles = lm.triangles().data();
     mf.num_triangles = lm.triangles().size();
     mf.frame = frame;

@@ -217,13 +217,16 @@ struct OutputSettings {
   std::string density_pattern = "density.####.vdb";  ///< '#' run = zero-padded frame
   std::string particles_pattern = "particles.####.ply";
   std::string stats_file = "stats.json";
-  bool density = true;          ///< write the density fog volume per frame
-  bool velocity = false;        ///< also write a vec3 `vel` grid
-  bool half_float = false;      ///< store grids as 16-bit floats
-  double voxel_size = 0.0;      ///< 0 = the grid spacing dx
-  bool particles = false;       ///< particle cache (positions, velocities) per frame
-  int checkpoint_every = 0;     ///< frames between checkpoints; 0 = none
-  std::string shell_pattern = "{name}.####.ply";  ///< per shell; {name} = the shell's name
+  bool density = true;  ///< write the density fog volume per frame
+  /// Also write a vec3 `vel` grid and, on PLY and GLB shell meshes, per-vertex velocities.
+  bool velocity = false;
+  bool half_float = false;   ///< store grids as 16-bit floats
+  double voxel_size = 0.0;   ///< 0 = the grid spacing dx
+  bool particles = false;    ///< particle cache (positions, velocities) per frame
+  int checkpoint_every = 0;  ///< frames between checkpoints; 0 = none
+  /// Per shell; {name} = the shell's name. The reader defaults the extension to
+  /// shell_format (".glb" for glb) and refuses a pattern that names another format.
+  std::string shell_pattern = "{name}.####.ply";
   std::string shell_format = "ply";  ///< ply (binary) | obj | glb
 };
 

@@ -95,4 +95,14 @@ void LimitMesh::evaluate(const Vec3* x, std::vector<Vec3>& pos, std::vector<Vec3
   }
 }
 
+void LimitMesh::evaluate_velocity(const Vec3* v, std::vector<Vec3>& vel) const {
+  vel.resize(rows_.size());
+  for (std::size_t r = 0; r < rows_.size(); ++r) {
+    const Row& row = rows_[r];
+    Vec3 u = Vec3::Zero();
+    for (std::size_t c = 0; c < row.ctrl.size(); ++c) u += row.n[c] * v[row.ctrl[c]];
+    vel[r] = u;
+  }
+}
+
 }  // namespace shellmpm

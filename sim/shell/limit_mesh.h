@@ -25,6 +25,10 @@ class LimitMesh {
   const std::vector<Real>& row_weights(std::size_t r) const { return rows_[r].n; }
   /// Limit positions and unit normals of the output vertices for control points x.
   void evaluate(const Vec3* x, std::vector<Vec3>& pos, std::vector<Vec3>& normal) const;
+  /// Velocities of the output vertices [m/s] for control-point velocities v [m/s]: the
+  /// position map applied to v, vel[r] = sum_k row_weights(r)[k] v[row_points(r)[k]],
+  /// so it is the exact time derivative of evaluate()'s positions. Same count and order.
+  void evaluate_velocity(const Vec3* v, std::vector<Vec3>& vel) const;
 
  private:
   struct Row {

@@ -59,6 +59,9 @@ class ShellObject {
   void output_mesh(std::vector<Vec3>& pos, std::vector<Vec3>& normal) const {
     limit_->evaluate(x.data(), pos, normal);
   }
+  /// Velocities [m/s] of the output mesh's vertices (same count and order as
+  /// output_mesh): the limit map applied to the control-point velocities v.
+  void output_velocity(std::vector<Vec3>& vel) const { limit_->evaluate_velocity(v.data(), vel); }
   const LimitMesh& limit_mesh() const { return *limit_; }
   const ShellDesc& desc() const { return desc_; }
   const ShellMaterialDesc& material() const { return mat_; }

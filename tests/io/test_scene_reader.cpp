@@ -966,6 +966,42 @@ TEST_CASE("bad shell scenes name the file, line and key", "[scene][shell]") {
   }
 }
 
+TEST_CASE(
+    "output.shell_pattern's default extension follows shell_format, a contradicting "
+    "one is refused",
+    "[scene]") {
+  for (const std::string fmt : {"ply", "obj", "glb"}) {
+    CAPTURE(fmt);
+    const Scene s = parse_scene(kHead + "output:\n  shell_format: " + fmt + "\n", "scenes/ok.yaml");
+    CHECK(s.output.shell_format == fmt);
+    CHECK(s.output.shell_pattern == "{name}.####." + fmt);
+    // The same through --set.
+    const Scene o = parse_scene(kHead, "scenes/ok.yaml", {"output.shell_format=" + fmt});
+    CHECK(o.output.shell_pattern == "{name}.####." + fmt);
+    // A given pattern with the format's extension is kept as written.
+    const Scene g = parse_scene(kHead + "output:\n  shell_format: " + fmt +
+                                    "\n  shell_pattern: \"meshes/{name}_####." + fmt + "\"\n",
+                                "scenes/ok.yaml");
+    CHECK(g.output.shell_pattern == "meshes/{name}_####." + fmt);
+  }
+  CHECK(parse_scene(kHead, "scenes/ok.yaml").output.shell_pattern == "{name}.####.ply");
+
+  // glTF in a file named .ply (issue 12, item 10), and the other mismatches: refused at
+  // the pattern's line, naming the format and the extension it needs.
+  expect_error(kHead + "output:\n  shell_format: glb\n  shell_pattern: \"{name}.####.ply\"\n", 7,
+               "output.shell_pattern",
+               {"must end in '.glb' for output.shell_format glb", "'{name}.####.ply'"});
+  expect_error(kHead + "output:\n  shell_pattern: \"{name}.####.obj\"\n", 6, "output.shell_pattern",
+               {"must end in '.ply' for output.shell_format ply"});
+  expect_error(kHead + "output:\n  shell_format: obj\n  shell_pattern: \"{name}.####\"\n", 7,
+               "output.shell_pattern", {"must end in '.obj'"});
+  expect_error(kHead + "output:\n  shell_format: glb\n  shell_pattern: \"{name}.####.GLB\"\n", 7,
+               "output.shell_pattern", {"must end in '.glb'"});
+  // A format from --set against a pattern in the file: reported at the pattern's line.
+  expect_error(kHead + "output:\n  shell_pattern: \"{name}.####.ply\"\n", 6, "output.shell_pattern",
+               {"must end in '.glb' for output.shell_format glb"}, {"output.shell_format=glb"});
+}
+
 TEST_CASE("docs/scene-format.md documents exactly the schema", "[scene]") {
   std::ifstream in(kSource + "/docs/scene-format.md");
   REQUIRE(in);

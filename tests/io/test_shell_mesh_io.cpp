@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
@@ -22,7 +23,9 @@
 #include "io/shell_mesh_reader.h"
 #include "io/shell_mesh_writer.h"
 #include "io/user_error.h"
+#include "render/ply_reader.h"
 #include "sim/core/check.h"
+#include "tests/support/ply_cache.h"
 #include "tests/support/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -203,6 +206,129 @@ TEST_CASE("PLY and GLB files are complete and carry frame and time", "[shellmesh
   CHECK(contains(json, "\"name\":\"cloth\""));
   CHECK(gb.size() == 20 + json_len + 8 + n * (12 + 12 + 8) + nt * 12);
 
+  CHECK(dir.temp_files() == 0);
+}
+
+namespace {
+
+/// Distinct per-vertex velocities [m/s] for a grid (so a writer that drops, reorders or
+/// shifts them cannot pass).
+std::vector<Vec3> grid_velocities(const Grid& g) {
+  std::vector<Vec3> v(g.positions.size());
+  for (std::size_t i = 0; i < v.size(); ++i)
+    v[i] = Vec3(Real(0.5) + Real(0.25) * i, Real(-2) * i, Real(1e-3) * i * i - Real(3));
+  return v;
+}
+
+/// The JSON chunk of a GLB file.
+nlohmann::json glb_json(const std::string& bytes) {
+  REQUIRE(bytes.size() > 20);
+  std::uint32_t json_len = 0;
+  std::memcpy(&json_len, bytes.data() + 12, 4);
+  REQUIRE(20 + json_len <= bytes.size());
+  return nlohmann::json::parse(bytes.substr(20, json_len));
+}
+
+/// The floats of accessor `a` of a GLB file (tightly packed, as the writer stores them).
+std::vector<float> glb_floats(const std::string& bytes, const nlohmann::json& j, int a) {
+  const nlohmann::json& acc = j["accessors"][a];
+  const nlohmann::json& view = j["bufferViews"][acc["bufferView"].get<int>()];
+  std::uint32_t json_len = 0;
+  std::memcpy(&json_len, bytes.data() + 12, 4);
+  const std::size_t bin = 20 + json_len + 8;
+  const std::size_t off = bin + view["byteOffset"].get<std::size_t>();
+  const std::size_t len = view["byteLength"].get<std::size_t>();
+  REQUIRE(off + len <= bytes.size());
+  std::vector<float> f(len / 4);
+  std::memcpy(f.data(), bytes.data() + off, len);
+  return f;
+}
+
+}  // namespace
+
+TEST_CASE("PLY and GLB carry per-vertex velocities in vertex order, none when not given",
+          "[shellmesh][velocity]") {
+  TempDir dir("shellmesh_velocity");
+  const Grid g(5, 4);
+  const std::size_t n = g.positions.size(), nt = g.triangles.size();
+  const std::vector<Vec3> vel = grid_velocities(g);
+  for (const bool uvs : {true, false}) {
+    INFO("uvs " << uvs);
+    MeshFrame f = g.frame(true, uvs);
+    f.velocities = vel.data();
+
+    // PLY: float vx vy vz after the other vertex properties, exact float values.
+    const std::string ply = dir.file(std::string("v") + (uvs ? "uv" : "") + ".ply");
+    write_shell_mesh(ply, f, MeshFormat::Ply);
+    const std::string pb = file_bytes(ply);
+    const std::string header = pb.substr(0, pb.find("end_header\n"));
+    CHECK(contains(header, "property float vx\nproperty float vy\nproperty float vz\n"));
+    CHECK(pb.size() == header.size() + 11 + n * (uvs ? 11 : 9) * 4 + nt * 13);
+    const shellmpm_test::TriMesh m = shellmpm_test::read_mesh_ply(ply);
+    REQUIRE(m.v.size() == n);
+    REQUIRE(m.x.size() == n);
+    for (std::size_t v = 0; v < n; ++v) {
+      INFO("vertex " << v);
+      for (int k = 0; k < 3; ++k) {
+        REQUIRE(m.v[v][k] == static_cast<float>(vel[v][k]));
+        REQUIRE(m.x[v][k] == static_cast<float>(g.positions[v][k]));
+      }
+    }
+    // Extra properties break neither assimp nor the preview renderer's reader.
+    check_indexed_readback(ply, g, true, uvs);
+    const PlyMesh rp = read_ply(ply);
+    REQUIRE(rp.positions.size() == n);
+    REQUIRE(rp.normals.size() == n);
+    REQUIRE(rp.triangles.size() == nt);
+    for (std::size_t v = 0; v < n; ++v) {
+      INFO("vertex " << v);
+      REQUIRE(rp.positions[v] == g.positions[v].cast<float>());
+      REQUIRE(rp.normals[v].x() == Approx(expected_normal(g, true, v).x()).margin(1e-6));
+    }
+    for (std::size_t t = 0; t < nt; ++t) REQUIRE(rp.triangles[t] == g.triangles[t]);
+
+    // GLB: a VEC3 float accessor _VELOCITY with one element per vertex, the indices last.
+    const std::string glb = dir.file(std::string("v") + (uvs ? "uv" : "") + ".glb");
+    write_shell_mesh(glb, f, MeshFormat::Glb);
+    const std::string gb = file_bytes(glb);
+    const nlohmann::json j = glb_json(gb);
+    const nlohmann::json& attrs = j["meshes"][0]["primitives"][0]["attributes"];
+    REQUIRE(attrs.contains("_VELOCITY"));
+    CHECK(attrs.contains("TEXCOORD_0") == uvs);
+    const int va = attrs["_VELOCITY"].get<int>();
+    const nlohmann::json& acc = j["accessors"][va];
+    CHECK(acc["count"].get<std::size_t>() == n);
+    CHECK(acc["type"] == "VEC3");
+    CHECK(acc["componentType"] == 5126);
+    const std::vector<float> gv = glb_floats(gb, j, va);
+    REQUIRE(gv.size() == 3 * n);
+    for (std::size_t v = 0; v < n; ++v)
+      for (int k = 0; k < 3; ++k) REQUIRE(gv[3 * v + k] == static_cast<float>(vel[v][k]));
+    const int ia = j["meshes"][0]["primitives"][0]["indices"].get<int>();
+    CHECK(j["accessors"][ia]["count"].get<std::size_t>() == 3 * nt);
+    CHECK(j["accessors"].size() == (uvs ? 5u : 4u));
+    std::uint32_t json_len = 0;
+    std::memcpy(&json_len, gb.data() + 12, 4);
+    CHECK(gb.size() == 20 + json_len + 8 + n * (12 + 12 + (uvs ? 8 : 0) + 12) + nt * 12);
+    check_indexed_readback(glb, g, true, uvs);  // assimp skips the custom attribute
+
+    // OBJ has no per-vertex attributes: the same file with or without velocities.
+    const std::string obj_v = dir.file("v.obj"), obj = dir.file("plain.obj");
+    write_shell_mesh(obj_v, f, MeshFormat::Obj);
+    write_shell_mesh(obj, g.frame(true, uvs), MeshFormat::Obj);
+    CHECK(file_bytes(obj_v) == file_bytes(obj));
+  }
+
+  // Without velocities: no vx property, no _VELOCITY attribute.
+  const std::string ply = dir.file("plain.ply"), glb = dir.file("plain.glb");
+  write_shell_mesh(ply, g.frame(true, true), MeshFormat::Ply);
+  write_shell_mesh(glb, g.frame(true, true), MeshFormat::Glb);
+  const shellmpm_test::TriMesh m = shellmpm_test::read_mesh_ply(ply);
+  CHECK(m.v.empty());
+  CHECK(std::find(m.vertex_properties.begin(), m.vertex_properties.end(), "vx") ==
+        m.vertex_properties.end());
+  const nlohmann::json j = glb_json(file_bytes(glb));
+  CHECK_FALSE(j["meshes"][0]["primitives"][0]["attributes"].contains("_VELOCITY"));
   CHECK(dir.temp_files() == 0);
 }
 

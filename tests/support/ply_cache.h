@@ -18,6 +18,10 @@ namespace shellmpm_test {
 struct TriMesh {
   std::vector<Eigen::Vector3d> x;
   std::vector<Eigen::Vector3i> tri;
+  /// Per-vertex velocities (`vx vy vz`) when the file has them, else empty.
+  std::vector<Eigen::Vector3d> v;
+  /// The vertex property names in file order.
+  std::vector<std::string> vertex_properties;
 };
 
 /// A particle cache frame: positions [m], velocities [m/s] and stable ids.
@@ -135,15 +139,23 @@ inline PlyFile read_ply(const std::string& path) {
 
 }  // namespace detail
 
-/// Reads a shell mesh frame: vertex positions and triangles (other properties skipped).
+/// Reads a shell mesh frame: vertex positions, velocities when present, and triangles
+/// (other properties skipped).
 inline TriMesh read_mesh_ply(const std::string& path) {
   const detail::PlyFile ply = detail::read_ply(path);
   TriMesh m;
+  bool has_v = false;
+  for (const detail::PlyElement& e : ply.elements)
+    if (e.name == "vertex")
+      for (const detail::PlyProperty& p : e.props) {
+        m.vertex_properties.push_back(p.name);
+        has_v = has_v || p.name == "vx";
+      }
   std::size_t off = 0;
   const std::string& b = ply.body;
   for (const detail::PlyElement& e : ply.elements) {
     for (std::size_t i = 0; i < e.count; ++i) {
-      Eigen::Vector3d x(0, 0, 0);
+      Eigen::Vector3d x(0, 0, 0), vel(0, 0, 0);
       for (const detail::PlyProperty& p : e.props) {
         if (p.list) {
           const int cs = detail::ply_type_size(p.count_type), vs = detail::ply_type_size(p.type);
@@ -167,11 +179,15 @@ inline TriMesh read_mesh_ply(const std::string& path) {
             if (p.name == "x") x.x() = v;
             if (p.name == "y") x.y() = v;
             if (p.name == "z") x.z() = v;
+            if (p.name == "vx") vel.x() = v;
+            if (p.name == "vy") vel.y() = v;
+            if (p.name == "vz") vel.z() = v;
           }
           off += s;
         }
       }
       if (e.name == "vertex") m.x.push_back(x);
+      if (e.name == "vertex" && has_v) m.v.push_back(vel);
     }
   }
   return m;
