@@ -33,9 +33,9 @@ struct CmdResult {
   std::string output;  ///< stdout and stderr together
 };
 
-/// Runs `shellmpm ARGS` through the shell, capturing output and the exit code.
-inline CmdResult run_shellmpm(const std::string& args) {
-  const std::string cmd = std::string(SHELLMPM_BINARY) + " " + args + " 2>&1";
+/// Runs `COMMAND` through the shell, capturing output (stdout and stderr) and the exit code.
+inline CmdResult run_command(const std::string& command) {
+  const std::string cmd = command + " 2>&1";
   CmdResult r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -45,6 +45,12 @@ inline CmdResult run_shellmpm(const std::string& args) {
   const int status = pclose(p);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+/// Runs `shellmpm ARGS` through the shell, capturing output and the exit code. `env`
+/// (e.g. "PATH=/nowhere") is put before the command, for that process alone.
+inline CmdResult run_shellmpm(const std::string& args, const std::string& env = "") {
+  return run_command((env.empty() ? "" : env + " ") + SHELLMPM_BINARY + " " + args);
 }
 
 inline std::string read_text(const std::string& path) {
