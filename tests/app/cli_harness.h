@@ -33,10 +33,9 @@ struct CmdResult {
   std::string output;  ///< stdout and stderr together
 };
 
-/// Runs `PREFIX shellmpm ARGS` through the shell (PREFIX: e.g. "timeout 10 "), capturing
-/// output and the exit code.
-inline CmdResult run_shellmpm_prefixed(const std::string& prefix, const std::string& args) {
-  const std::string cmd = prefix + std::string(SHELLMPM_BINARY) + " " + args + " 2>&1";
+/// Runs `COMMAND` through the shell, capturing output (stdout and stderr) and the exit code.
+inline CmdResult run_command(const std::string& command) {
+  const std::string cmd = command + " 2>&1";
   CmdResult r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -48,8 +47,16 @@ inline CmdResult run_shellmpm_prefixed(const std::string& prefix, const std::str
   return r;
 }
 
-/// Runs `shellmpm ARGS` through the shell, capturing output and the exit code.
-inline CmdResult run_shellmpm(const std::string& args) { return run_shellmpm_prefixed("", args); }
+/// Runs `shellmpm ARGS` through the shell, capturing output and the exit code. `env`
+/// (e.g. "PATH=/nowhere") is put before the command, for that process alone.
+inline CmdResult run_shellmpm(const std::string& args, const std::string& env = "") {
+  return run_command((env.empty() ? "" : env + " ") + SHELLMPM_BINARY + " " + args);
+}
+
+/// Runs `PREFIX shellmpm ARGS` (PREFIX: e.g. "timeout 10 ").
+inline CmdResult run_shellmpm_prefixed(const std::string& prefix, const std::string& args) {
+  return run_command(prefix + SHELLMPM_BINARY + " " + args);
+}
 
 inline std::string read_text(const std::string& path) {
   std::ifstream f(path, std::ios::binary);

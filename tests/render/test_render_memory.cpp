@@ -40,9 +40,27 @@ PreviewScene moving_scene(int frame) {
   return s;
 }
 
+// Under AddressSanitizer (-DSHELLMPM_SANITIZE=ON) freed blocks wait in a quarantine of
+// up to 256 MB before their memory is reused, so resident size grows by design and these
+// checks cannot work; the sanitizer still reports any leak at exit.
+#ifdef SHELLMPM_SANITIZE
+#define SKIP_UNDER_SANITIZER()                                                               \
+  do {                                                                                       \
+    WARN(                                                                                    \
+        "skipped in the sanitizer build: ASan's quarantine holds freed memory, so resident " \
+        "size cannot show a leak (LeakSanitizer checks at exit instead)");                   \
+    return;                                                                                  \
+  } while (false)
+#else
+#define SKIP_UNDER_SANITIZER() \
+  do {                         \
+  } while (false)
+#endif
+
 }  // namespace
 
 TEST_CASE("100 frames in one process keep resident memory flat in both paths", "[render][memory]") {
+  SKIP_UNDER_SANITIZER();
   const Camera cam = camera_at(Vec3d(0.5, 1.5, 3.0), Vec3d(0, 0.3, 0), 160, 120);
   RasterRenderer raster(2);
   RayTracer rt(2);
@@ -60,7 +78,9 @@ TEST_CASE("100 frames in one process keep resident memory flat in both paths", "
   }
 }
 
-TEST_CASE("creating and destroying renderers releases their contexts and devices", "[render][memory]") {
+TEST_CASE("creating and destroying renderers releases their contexts and devices",
+          "[render][memory]") {
+  SKIP_UNDER_SANITIZER();
   const Camera cam = camera_at(Vec3d(0.5, 1.5, 3.0), Vec3d(0, 0.3, 0), 96, 64);
   const PreviewScene s = moving_scene(1);
   double base = 0;
