@@ -1,5 +1,7 @@
 #include "sim/contact/shell_guard.h"
 
+#include "sim/core/parallel.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -58,8 +60,9 @@ double distance_of_segments(const Vec3d& p0, const Vec3d& p1, const Vec3d& q0, c
 
 }  // namespace
 
-void ShellGuard::setup(const std::vector<GridShell>& shells, double gap) {
+void ShellGuard::setup(const std::vector<GridShell>& shells, double gap, bool serial) {
   gap_ = gap;
+  serial_ = serial;
   meshes_.clear();
   point_offset_.assign(1, 0);
   vertex_offset_.assign(1, 0);
@@ -151,55 +154,71 @@ void ShellGuard::build_shell_candidates(double radius) {
   const auto local = [&](std::size_t g) {
     return static_cast<int>(g - vertex_offset_[vert_shell_[g]]);
   };
-  std::vector<int> cand;
-  stamp_.assign(std::max(all_tris_.size(), all_edges_.size()), -1);
-  for (std::size_t p = 0; p < pos_.size(); ++p) {
-    const int pi = static_cast<int>(p);
-    cand.clear();
-    tri_grid_.for_each_in_box(pos_[p] - pad, pos_[p] + pad, [&](int t) {
-      if (stamp_[static_cast<std::size_t>(t)] == pi) return;
-      stamp_[static_cast<std::size_t>(t)] = pi;
-      const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
-      if (T[0] == pi || T[1] == pi || T[2] == pi) return;
-      if (boxes_apart<1, 3>({&pos_[p]}, {&pos_[T[0]], &pos_[T[1]], &pos_[T[2]]}, radius)) return;
-      if (!(distance_to_triangle(pos_[p], pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius)) return;
-      const std::size_t s = vert_shell_[p];
-      if (s == vert_shell_[T[0]]) {
-        const std::vector<Vec3d>& R = meshes_[s].rest;
-        if (distance_to_triangle(R[local(p)], R[local(T[0])], R[local(T[1])], R[local(T[2])]) <
-            meshes_[s].near)
-          return;
-      }
-      cand.push_back(t);
-    });
-    std::sort(cand.begin(), cand.end());
-    for (int t : cand) vt_cand_.emplace_back(pi, t);
-  }
-  stamp_.assign(stamp_.size(), -1);
-  for (std::size_t e = 0; e < all_edges_.size(); ++e) {
-    const Eigen::Vector3i& E = all_edges_[e];
-    const Vec3d &p0 = pos_[E[0]], &p1 = pos_[E[1]];
-    const int ei = static_cast<int>(e);
-    cand.clear();
-    edge_grid_.for_each_in_box(p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad, [&](int f) {
-      if (f <= ei || stamp_[static_cast<std::size_t>(f)] == ei) return;
-      stamp_[static_cast<std::size_t>(f)] = ei;
-      const Eigen::Vector3i& F = all_edges_[static_cast<std::size_t>(f)];
-      if (F[0] == E[0] || F[0] == E[1] || F[1] == E[0] || F[1] == E[1]) return;
-      if (boxes_apart<2, 2>({&p0, &p1}, {&pos_[F[0]], &pos_[F[1]]}, radius)) return;
-      if (!(distance_of_segments(p0, p1, pos_[F[0]], pos_[F[1]]) < radius)) return;
-      const std::size_t s = vert_shell_[E[0]];
-      if (s == vert_shell_[F[0]]) {
-        const std::vector<Vec3d>& R = meshes_[s].rest;
-        if (distance_of_segments(R[local(E[0])], R[local(E[1])], R[local(F[0])],
-                                 R[local(F[1])]) < meshes_[s].near)
-          return;
-      }
-      cand.push_back(f);
-    });
-    std::sort(cand.begin(), cand.end());
-    for (int f : cand) ee_cand_.emplace_back(ei, f);
-  }
+  // Vertices, then edges, in chunks on the threads; each chunk keeps its own stamps and
+  // pairs, and the chunks' pairs are joined in order (the same lists on any thread count).
+  const std::size_t grain = 512;
+  const auto chunked = [&](std::size_t n, std::size_t stamps, std::vector<Eigen::Vector2i>& out,
+                           const auto& visit) {
+    const std::size_t chunks = (n + grain - 1) / grain;
+    std::vector<std::vector<Eigen::Vector2i>> parts(chunks);
+    parallel_for(
+        n, grain,
+        [&](std::size_t b, std::size_t e) {
+          std::vector<int> stamp(stamps, -1), cand;
+          for (std::size_t i = b; i < e; ++i) {
+            cand.clear();
+            visit(i, stamp, cand);
+            std::sort(cand.begin(), cand.end());
+            for (int f : cand) parts[b / grain].emplace_back(static_cast<int>(i), f);
+          }
+        },
+        serial_);
+    for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
+  };
+  chunked(pos_.size(), all_tris_.size(), vt_cand_,
+          [&](std::size_t p, std::vector<int>& stamp, std::vector<int>& cand) {
+            const int pi = static_cast<int>(p);
+            tri_grid_.for_each_in_box(pos_[p] - pad, pos_[p] + pad, [&](int t) {
+              if (stamp[static_cast<std::size_t>(t)] == pi) return;
+              stamp[static_cast<std::size_t>(t)] = pi;
+              const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
+              if (T[0] == pi || T[1] == pi || T[2] == pi) return;
+              if (boxes_apart<1, 3>({&pos_[p]}, {&pos_[T[0]], &pos_[T[1]], &pos_[T[2]]}, radius))
+                return;
+              if (!(distance_to_triangle(pos_[p], pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius))
+                return;
+              const std::size_t s = vert_shell_[p];
+              if (s == vert_shell_[T[0]]) {
+                const std::vector<Vec3d>& R = meshes_[s].rest;
+                if (distance_to_triangle(R[local(p)], R[local(T[0])], R[local(T[1])],
+                                         R[local(T[2])]) < meshes_[s].near)
+                  return;
+              }
+              cand.push_back(t);
+            });
+          });
+  chunked(all_edges_.size(), all_edges_.size(), ee_cand_,
+          [&](std::size_t e, std::vector<int>& stamp, std::vector<int>& cand) {
+            const Eigen::Vector3i& E = all_edges_[e];
+            const Vec3d &p0 = pos_[E[0]], &p1 = pos_[E[1]];
+            const int ei = static_cast<int>(e);
+            edge_grid_.for_each_in_box(p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad, [&](int f) {
+              if (f <= ei || stamp[static_cast<std::size_t>(f)] == ei) return;
+              stamp[static_cast<std::size_t>(f)] = ei;
+              const Eigen::Vector3i& F = all_edges_[static_cast<std::size_t>(f)];
+              if (F[0] == E[0] || F[0] == E[1] || F[1] == E[0] || F[1] == E[1]) return;
+              if (boxes_apart<2, 2>({&p0, &p1}, {&pos_[F[0]], &pos_[F[1]]}, radius)) return;
+              if (!(distance_of_segments(p0, p1, pos_[F[0]], pos_[F[1]]) < radius)) return;
+              const std::size_t s = vert_shell_[E[0]];
+              if (s == vert_shell_[F[0]]) {
+                const std::vector<Vec3d>& R = meshes_[s].rest;
+                if (distance_of_segments(R[local(E[0])], R[local(E[1])], R[local(F[0])],
+                                         R[local(F[1])]) < meshes_[s].near)
+                  return;
+              }
+              cand.push_back(f);
+            });
+          });
 }
 
 void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, double dt) {

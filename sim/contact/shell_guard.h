@@ -69,8 +69,8 @@ struct ShellGuardStats {
 
 class ShellGuard {
  public:
-  /// The shells' topology is fixed from here on. gap [m] > 0.
-  void setup(const std::vector<GridShell>& shells, double gap);
+  /// The shells' topology is fixed from here on. gap [m] > 0; serial: no threads.
+  void setup(const std::vector<GridShell>& shells, double gap, bool serial = false);
   double gap() const { return gap_; }
   /// One pass after G2P (see the file comment): changes v and x of control points.
   ShellGuardStats apply(std::vector<GridShell>& shells, const GuardBulk& bulk, double dt);
@@ -130,6 +130,7 @@ class ShellGuard {
   };
 
   double gap_ = 0;
+  bool serial_ = false;
   std::vector<Mesh> meshes_;
   std::vector<std::size_t> point_offset_;   ///< first control point of each shell
   std::vector<std::size_t> vertex_offset_;  ///< first limit vertex of each shell

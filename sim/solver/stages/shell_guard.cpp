@@ -22,7 +22,7 @@ double ShellGuardStage::gap(const Scene& s) {
 
 void ShellGuardStage::run(StepContext& c) {
   if (!ready_) {
-    guard_.setup(c.grid_shells, gap(c.scene));
+    guard_.setup(c.grid_shells, gap(c.scene), c.opt.serial);
     ready_ = true;
   }
   GuardBulk bulk;
