@@ -5,6 +5,7 @@
 #include "io/available_memory.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
+#include "sim/solver/stages/shell_guard.h"
 #include "sim/solver/step_limits.h"
 
 namespace shellmpm {
@@ -76,6 +77,10 @@ int check_command(const CommonArgs& a) {
   std::string stages;
   for (const std::string& n : solver.stage_names()) stages += (stages.empty() ? "" : ", ") + n;
   std::printf("stages: %s\n", stages.empty() ? "(none: nothing to simulate)" : stages.c_str());
+  if (ShellGuardStage::needed(scene))
+    std::printf("shell guard: gap %g m (%s)\n", ShellGuardStage::gap(scene),
+                scene.shot.shell_guard_gap > 0 ? "shot.shell_guard_gap"
+                                               : "0.05 dx or the thickest contact shell");
   for (std::size_t si = 0; si < solver.shells().size(); ++si) {
     const auto& sh = solver.shells()[si];
     const ShellMaterialDesc& m = scene.shell_materials[sh->desc().material];

@@ -13,6 +13,8 @@ TEST_CASE("CLI: check reports contact and warns when the mesh spacing is far fro
   INFO(ok.output);
   CHECK(ok.code == 0);
   CHECK(ok.output.find("contact: 3200 contact particles") != std::string::npos);
+  // dx 0.025, cloth 1 mm: the guard's gap is 0.05 dx.
+  CHECK(ok.output.find("shell guard: gap 0.00125 m") != std::string::npos);
   CHECK(ok.output.find("warning") == std::string::npos);
   const CmdResult fine = run_shellmpm("check " + scene + " --set shot.dx=0.01");
   INFO(fine.output);
