@@ -230,7 +230,6 @@ void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, dou
   if (!ps || ps->size() == 0 || pos_.empty()) return;
   bulk_grid_.build(pos_, all_tris_, cell_size(radius), 0.0);
   const Vec3d pad = Vec3d::Constant(radius);
-  std::vector<int> cand;
   Vec3d lo = pos_[0], hi = pos_[0];
   for (const Vec3d& q : pos_) {
     lo = lo.cwiseMin(q);
@@ -238,25 +237,38 @@ void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, dou
   }
   lo.array() -= radius;
   hi.array() += radius;
-  stamp_.assign(all_tris_.size(), -1);
-  for (std::size_t p = 0; p < ps->size(); ++p) {
-    const Vec3d x = to_d(ps->x[p]) - dt * to_d(ps->v[p]);
-    if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
-    // Stamps are the particle index modulo 2^31 (distinct for neighbouring queries).
-    const int id = static_cast<int>(p & 0x7fffffff);
-    cand.clear();
-    bulk_grid_.for_each_in_box(x - pad, x + pad, [&](int t) {
-      if (stamp_[static_cast<std::size_t>(t)] == id) return;
-      stamp_[static_cast<std::size_t>(t)] = id;
-      const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
-      if (boxes_apart<1, 3>({&x}, {&pos_[T[0]], &pos_[T[1]], &pos_[T[2]]}, radius)) return;
-      if (distance_to_triangle(x, pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius) cand.push_back(t);
-    });
-    if (cand.empty()) continue;
-    std::sort(cand.begin(), cand.end());
-    bulk_idx_.push_back(static_cast<std::uint32_t>(p));
-    for (int t : cand) bt_cand_.emplace_back(static_cast<int>(bulk_idx_.size() - 1), t);
-  }
+  // Chunks of particles on the threads, each with its own stamps and (particle,
+  // triangle) pairs, joined in order.
+  const std::size_t grain = 4096, n = ps->size();
+  std::vector<std::vector<std::pair<std::uint32_t, int>>> parts((n + grain - 1) / grain);
+  parallel_for(
+      n, grain,
+      [&](std::size_t b, std::size_t e) {
+        std::vector<int> stamp(all_tris_.size(), -1), cand;
+        auto& out = parts[b / grain];
+        for (std::size_t p = b; p < e; ++p) {
+          const Vec3d x = to_d(ps->x[p]) - dt * to_d(ps->v[p]);
+          if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
+          const int id = static_cast<int>(p - b);  // distinct within the chunk
+          cand.clear();
+          bulk_grid_.for_each_in_box(x - pad, x + pad, [&](int t) {
+            if (stamp[static_cast<std::size_t>(t)] == id) return;
+            stamp[static_cast<std::size_t>(t)] = id;
+            const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
+            if (boxes_apart<1, 3>({&x}, {&pos_[T[0]], &pos_[T[1]], &pos_[T[2]]}, radius)) return;
+            if (distance_to_triangle(x, pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius)
+              cand.push_back(t);
+          });
+          std::sort(cand.begin(), cand.end());
+          for (int t : cand) out.emplace_back(static_cast<std::uint32_t>(p), t);
+        }
+      },
+      serial_);
+  for (const auto& part : parts)
+    for (const auto& [p, t] : part) {
+      if (bulk_idx_.empty() || bulk_idx_.back() != p) bulk_idx_.push_back(p);
+      bt_cand_.emplace_back(static_cast<int>(bulk_idx_.size() - 1), t);
+    }
 }
 
 bool ShellGuard::point_triangle_pair(const Vec3d& x, const Eigen::Vector3i& T, double r,

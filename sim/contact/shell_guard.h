@@ -155,7 +155,6 @@ class ShellGuard {
   std::vector<Vec3d> edge_tri_pos_;
   std::vector<Eigen::Vector3i> all_edges_;  ///< edges as degenerate triangles (a, b, b)
   TriangleGrid tri_grid_, edge_grid_, bulk_grid_;  ///< used by the list builds only
-  std::vector<int> stamp_;  ///< last query that saw each feature (list builds)
   std::vector<Entry> entries_;
   std::vector<Pair> pairs_;
 };
