@@ -18,6 +18,18 @@ inline T atanh_over_x(T x) {
   return std::atanh(x) / x;
 }
 
+/// The elastic block's metric C = Bp^T M Bp (M = [m11 m12; m12 m22], the deformed metric;
+/// columns of Bp: (Bp[0], Bp[2]) and (Bp[1], Bp[3])), its three distinct entries.
+template <class T>
+inline void layer_metric(const T* Bp, T m11, T m12, T m22, T& c11, T& c12, T& c22) {
+  const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
+  const T mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
+  const T mb1x = m11 * b01 + m12 * b11, mb1y = m12 * b01 + m22 * b11;
+  c11 = b00 * mb0x + b10 * mb0y;
+  c12 = b00 * mb1x + b10 * mb1y;
+  c22 = b01 * mb1x + b11 * mb1y;
+}
+
 /// Laminate energy density of one layer (supplement secs. 3-4) from the current metric
 /// M = [g_a . g_b] (m11, m12, m22) and Bp (row-major 2x2): C = Bp^T M Bp has eigenvalues
 /// s_a^2 and psi = mu/4 |log C|^2 + lambda/8 (log det C)^2 = mu |log s|^2 +
@@ -33,13 +45,9 @@ inline T atanh_over_x(T x) {
 /// cancellation at s_1 = s_2). Only s_1 > s_l >= s_2: c_1 - c_2 = 2h >= s_1^2 - s_l^2 > 0.
 template <class T, class Stiffening>
 inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m12, T m22, T* S) {
-  // Columns of Bp: (Bp[0], Bp[2]) and (Bp[1], Bp[3]).
   const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
-  const T mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
-  const T mb1x = m11 * b01 + m12 * b11, mb1y = m12 * b01 + m22 * b11;
-  const T c11 = b00 * mb0x + b10 * mb0y;
-  const T c12 = b00 * mb1x + b10 * mb1y;
-  const T c22 = b01 * mb1x + b11 * mb1y;
+  T c11, c12, c22;
+  layer_metric(Bp, m11, m12, m22, c11, c12, c22);
   const T tr = c11 + c22;
   const T det = c11 * c22 - c12 * c12;
   const T hd = T(0.5) * (c11 - c22);
@@ -92,12 +100,8 @@ inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m
 /// Log singular values (log s1, log s2) of the elastic block (for statistics).
 template <class T>
 inline void layer_log_s(const T* Bp, T m11, T m12, T m22, T& l1, T& l2) {
-  const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
-  const T mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
-  const T mb1x = m11 * b01 + m12 * b11, mb1y = m12 * b01 + m22 * b11;
-  const T c11 = b00 * mb0x + b10 * mb0y;
-  const T c12 = b00 * mb1x + b10 * mb1y;
-  const T c22 = b01 * mb1x + b11 * mb1y;
+  T c11, c12, c22;
+  layer_metric(Bp, m11, m12, m22, c11, c12, c22);
   const T tr = c11 + c22;
   const T hd = T(0.5) * (c11 - c22);
   const T x = T(2) * std::sqrt(hd * hd + c12 * c12) / tr;
