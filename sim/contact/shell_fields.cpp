@@ -14,12 +14,45 @@ constexpr Real kBulkMin = Real(1e-3);    ///< bulk share of a node's mass that g
 constexpr Real kShellOnly = Real(1e-4);  ///< below this bulk share the node is shells only
 }  // namespace
 
-void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bulk) {
+void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells) {
   fields_.clear();
-  active_ = num_shells >= 2 || (num_shells >= 1 && bulk);
+  active_ = num_shells >= 1;
   if (!active_) return;
   fields_.resize(num_shells);
   for (Field& f : fields_) f.grid.setup(grid.dx(), grid.origin());
+}
+
+ShellFields::PointShare::PointShare(const GridShell& gs, const Vec3& nj, const Vec3& f,
+                                   std::uint32_t j, Real dx, Real dt)
+    : m(gs.shell->mass[j]),
+      mh(gs.held[j] == 7 ? m : Real(0)),
+      align(nj.dot(kAlign) >= 0 ? Real(1) : Real(-1)),
+      fx(f),
+      n(nj) {
+  A = (m * dx) * gs.contact->C[j];
+  base = m * gs.shell->v[j] + dt * gs.force[j] - A * fx;
+}
+
+void ShellFields::PointShare::add(Node& d, Real w, int i, int j, int k) const {
+  const Vec3 ijk{Real(i), Real(j), Real(k)};
+  const Vec3 mom = w * (base + A * ijk);
+  // The normal turned to the node's side of the shell.
+  const Real side = n.dot(ijk - fx);
+  const Real wn = side > 0 ? w * m : side < 0 ? -w * m : Real(0);
+  const Vec3 off = fx - ijk;
+  d.m += w * m;
+  d.held += w * mh;
+  for (int a = 0; a < 3; ++a) {
+    d.p[a] += mom[a];
+    d.n[a] += wn * n[a];
+    d.N[a] += w * m * n[a];
+    d.o[a] += w * m * off[a];
+  }
+  if (w > 0) {
+    const Real h = align * side;  // fold_height
+    d.hmin = std::min(d.hmin, h);
+    d.hmax = std::max(d.hmax, h);
+  }
 }
 
 void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial) {
@@ -46,37 +79,18 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
       [&](std::size_t bb, std::size_t be) {
         for (std::size_t b = bb; b < be; ++b) {
           auto& buf = F.buf[b];
-          std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
+          Node::clear(buf.data(), buf.size());
           const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
           for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
             const std::uint32_t j = F.grid.order[q];
-            const Real m = sh.mass[j];
             const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
-            const Mat3 A = (m * dx) * gs.contact->C[j];
-            const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-            const Vec3 base = m * sh.v[j] + dt * gs.force[j] - A * fx;
-            const Vec3& nj = F.normal[j];
-            const Real mh = gs.held[j] == 7 ? m : Real(0);
+            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt);
             const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
             for (int i = 0; i < 3; ++i)
               for (int jj = 0; jj < 3; ++jj)
-                for (int k = 0; k < 3; ++k) {
-                  const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];
-                  const Vec3 mom = w * (base + A * Vec3(Real(i), Real(jj), Real(k)));
-                  // The normal turned to the node's side of the shell.
-                  const Real side = nj.dot(Vec3(Real(i), Real(jj), Real(k)) - fx);
-                  const Real wn = side > 0 ? w * m : side < 0 ? -w * m : Real(0);
-                  Node& nd = buf[pad_node(lx + i, ly + jj, lz + k)];
-                  const Vec3 off = fx - Vec3(Real(i), Real(jj), Real(k));
-                  nd.m += w * m;
-                  nd.held += w * mh;
-                  for (int a = 0; a < 3; ++a) {
-                    nd.p[a] += mom[a];
-                    nd.n[a] += wn * nj[a];
-                    nd.N[a] += w * m * nj[a];
-                    nd.o[a] += w * m * off[a];
-                  }
-                }
+                for (int k = 0; k < 3; ++k)
+                  P.add(buf[pad_node(lx + i, ly + jj, lz + k)], W.w[0][i] * W.w[1][jj] * W.w[2][k],
+                        i, jj, k);
           }
         }
       },
@@ -86,26 +100,30 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
       [&](std::size_t gb, std::size_t ge) {
         for (std::size_t g = gb; g < ge; ++g) {
           auto& nodes = F.nodes[g];
-          std::memset(static_cast<void*>(nodes.data()), 0, sizeof(nodes));
+          Node::clear(nodes.data(), nodes.size());
           F.r[g].fill(Vec3::Zero());
           F.grid.for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
-            const Node& from = F.buf[src][sn];
-            Node& d = nodes[dn];
-            d.m += from.m;
-            d.held += from.held;
-            for (int a = 0; a < 3; ++a) {
-              d.p[a] += from.p[a];
-              d.n[a] += from.n[a];
-              d.N[a] += from.N[a];
-              d.o[a] += from.o[a];
-            }
+            nodes[dn] += F.buf[src][sn];
           });
-          for (Node& d : nodes)
-            if (d.m > 0)
-              for (int a = 0; a < 3; ++a) {
-                d.p[a] /= d.m;
-                d.o[a] /= d.m;
-              }
+        }
+      },
+      serial);
+  split_folds(F, gs, dt, serial);
+  // Momentum to velocity, first moment to centroid offset.
+  const auto normalise = [](Node& d) {
+    if (d.m > 0)
+      for (int a = 0; a < 3; ++a) {
+        d.p[a] /= d.m;
+        d.o[a] /= d.m;
+      }
+  };
+  parallel_for(
+      ng, 16,
+      [&](std::size_t gb, std::size_t ge) {
+        for (std::size_t g = gb; g < ge; ++g) {
+          for (Node& d : F.nodes[g]) normalise(d);
+          if (F.fold[g] >= 0)
+            for (Node& d : F.folds[F.fold[g]].second) normalise(d);
         }
       },
       serial);
@@ -206,9 +224,15 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   parallel_for(
       ng, 4,
       [&](std::size_t gb, std::size_t ge) {
-        std::vector<int> ids;
-        std::vector<Vec3> vel(K), nrm(K), own(K), off(K);
-        std::vector<Real> winv(K);
+        // The bodies at a node: each shell here, or each of its two classes where it folds.
+        struct Body {
+          int shell;
+          const Node* f;
+          Vec3* r;
+          Vec3 vel, nrm, own, off;  ///< velocity, normal to the node, own normal, centroid
+          Real winv;                ///< inverse effective mass (pinned share: infinite)
+        };
+        std::vector<Body> bodies;
         for (std::size_t g = gb; g < ge; ++g) {
           if (!fielded_[g]) continue;
           const int* fb = fblock_.data() + g * K;
@@ -216,63 +240,63 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
           for (int n = 0; n < kBlockNodes; ++n) {
             const GridNode& cn = combined.gblock_nodes[g][n];
             if (cn.m <= 0) continue;
+            bodies.clear();
             Real ms = 0;
-            Vec3 ps = Vec3::Zero();
-            int cnt = 0;
             for (std::size_t s = 0; s < K; ++s) {
               if (fb[s] < 0) continue;
-              const Node& f = fields_[s].nodes[fb[s]][n];
-              if (f.m <= 0) continue;
-              ms += f.m;
-              ps += f.m * Vec3(f.p[0], f.p[1], f.p[2]);
-              ++cnt;
+              Field& F = fields_[s];
+              const auto push = [&](const Node& f, Vec3& r) {
+                if (f.m <= 0) return;
+                ms += f.m;
+                bodies.push_back({static_cast<int>(s), &f, &r, Vec3(f.p[0], f.p[1], f.p[2]),
+                                  Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Real(0)});
+              };
+              push(F.nodes[fb[s]][n], F.r[fb[s]][n]);
+              const int fi = F.fold[fb[s]];
+              if (fi >= 0) push(F.folds[fi].second[n], F.folds[fi].r[n]);
             }
             const Real mk = cn.m - ms;  // the bulk material's share
             const bool bulk = mk >= kBulkMin * cn.m;
+            const std::size_t cnt = bodies.size();
             if (cnt == 0 || cnt + (bulk ? 1 : 0) < 2) continue;
             if (!bulk && mk > kShellOnly * cn.m) continue;  // a sliver of bulk: one velocity
             const Vec3 p(cn.v[0], cn.v[1], cn.v[2]);
             const Vec3 v0 = p / cn.m;
+            Vec3 ps = Vec3::Zero();
+            for (const Body& B : bodies) ps += B.f->m * B.vel;
             Vec3 vk = bulk ? Vec3((p - ps) / mk) : Vec3::Zero();
-            // The shells here: velocity, normal towards the node, own normal and centroid
-            // offset, inverse effective mass (the pinned share infinitely heavy: m^2 / free).
-            ids.clear();
-            for (std::size_t s = 0; s < K; ++s) {
-              if (fb[s] < 0) continue;
-              const Node& f = fields_[s].nodes[fb[s]][n];
-              if (f.m <= 0) continue;
+            for (Body& B : bodies) {
+              const Node& f = *B.f;
               const Vec3 ns(f.n[0], f.n[1], f.n[2]), Ns(f.N[0], f.N[1], f.N[2]);
               const Real nl = ns.norm(), Nl = Ns.norm();
-              ids.push_back(static_cast<int>(s));
-              vel[s] = Vec3(f.p[0], f.p[1], f.p[2]);
-              nrm[s] = nl > 0 ? Vec3(ns / nl) : Vec3::Zero();
-              own[s] = Nl > 0 ? Vec3(Ns / Nl) : Vec3::Zero();
-              off[s] = Vec3(f.o[0], f.o[1], f.o[2]);
-              winv[s] = std::max(f.m - f.held, Real(0)) / (f.m * f.m);
+              B.nrm = nl > 0 ? Vec3(ns / nl) : Vec3::Zero();
+              B.own = Nl > 0 ? Vec3(Ns / Nl) : Vec3::Zero();
+              B.off = Vec3(f.o[0], f.o[1], f.o[2]);
+              B.winv = std::max(f.m - f.held, Real(0)) / (f.m * f.m);
             }
             // Shell against shell (facing across the node, or stacked on one side of it),
             // then each shell against the bulk field: Bardenhagen's rule.
-            for (std::size_t i = 0; i < ids.size(); ++i)
-              for (std::size_t j = i + 1; j < ids.size(); ++j) {
-                const int a = ids[i], b = ids[j];
-                const Real facing = nrm[a].dot(nrm[b]);
+            for (std::size_t i = 0; i < cnt; ++i)
+              for (std::size_t j = i + 1; j < cnt; ++j) {
+                Body &A = bodies[i], &B = bodies[j];
+                const Real facing = A.nrm.dot(B.nrm);
                 Vec3 nab;  // unit normal from a towards b
                 if (facing < Real(-0.5)) {
-                  nab = (nrm[a] - nrm[b]).normalized();
+                  nab = (A.nrm - B.nrm).normalized();
                 } else if (facing > Real(0.5)) {
                   // Both on the same side of the node: closer than a cell, no node between
                   // them. The one whose centroid lies nearer the node along their common
                   // normal u is in front; without this the rule let go exactly when two
                   // sheets were pressed closest (hanging curtains hit at 20 m/s crossed).
-                  const Vec3 u = (nrm[a] + nrm[b]).normalized();
-                  const Real h = u.dot(off[b] - off[a]);
+                  const Vec3 u = (A.nrm + B.nrm).normalized();
+                  const Real h = u.dot(B.off - A.off);
                   if (std::abs(h) < Real(0.05)) continue;
                   nab = h > 0 ? u : Vec3(-u);
                 } else {
                   continue;
                 }
-                field_contact(nab, std::sqrt(friction_[a] * friction_[b]), winv[a], vel[a], winv[b],
-                             vel[b]);
+                field_contact(nab, std::sqrt(friction_[A.shell] * friction_[B.shell]), A.winv,
+                              A.vel, B.winv, B.vel);
               }
             if (bulk) {
               // Which side of a shell the bulk material is on: where its mass centroid lies
@@ -292,17 +316,17 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
                   have_ok = true;
                 }
               }
-              for (int a : ids) {
-                Vec3 nb = nrm[a];
-                if (have_ok && own[a].squaredNorm() > 0) {
-                  const Real d = own[a].dot(ok - off[a]);
-                  if (std::abs(d) > Real(0.05)) nb = d > 0 ? own[a] : Vec3(-own[a]);
+              for (Body& B : bodies) {
+                Vec3 nb = B.nrm;
+                if (have_ok && B.own.squaredNorm() > 0) {
+                  const Real d = B.own.dot(ok - B.off);
+                  if (std::abs(d) > Real(0.05)) nb = d > 0 ? B.own : Vec3(-B.own);
                 }
                 if (nb.squaredNorm() > 0)
-                  field_contact(nb, friction_[a], winv[a], vel[a], Real(1) / mk, vk);
+                  field_contact(nb, friction_[B.shell], B.winv, B.vel, Real(1) / mk, vk);
               }
             }
-            for (int a : ids) fields_[a].r[fb[a]][n] = vel[a] - v0;
+            for (const Body& B : bodies) *B.r = B.vel - v0;
             if (bulk) r_bulk_[g][n] = vk - v0;
             shared_[g] |= std::uint64_t(1) << n;
           }
@@ -326,8 +350,13 @@ void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool seri
             const Vec3 rk = r_bulk_[g][n];
             for (std::size_t s = 0; s < K; ++s) {
               if (fb[s] < 0) continue;
-              Vec3& r = fields_[s].r[fb[s]][n];
+              Field& F = fields_[s];
+              Vec3& r = F.r[fb[s]][n];
               r = one ? Vec3::Zero() : Vec3(r - rk);
+              const int fi = F.fold[fb[s]];
+              if (fi < 0) continue;
+              Vec3& r2 = F.folds[fi].r[n];
+              r2 = one ? Vec3::Zero() : Vec3(r2 - rk);
             }
             if (one) continue;
             GridNode& nd = combined.gblock_nodes[g][n];
@@ -365,7 +394,12 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
                   for (int k = 0; k < 3; ++k) {
                     const int px = lx + i, py = ly + jj, pz = lz + k;
                     const int o = (px >> 2) * 4 + (py >> 2) * 2 + (pz >> 2);
-                    const Vec3& rn = F.r[nbr[o]][block_node(px & 3, py & 3, pz & 3)];
+                    const int bn = block_node(px & 3, py & 3, pz & 3);
+                    const int fi = F.fold[nbr[o]];
+                    // Where the shell folds, the control point reads its own class.
+                    const bool second = fi >= 0 && is_split(F.folds[fi], bn) &&
+                                        fold_height(F.normal[j], fx, i, jj, k) >= F.folds[fi].cut[bn];
+                    const Vec3& rn = second ? F.folds[fi].r[bn] : F.r[nbr[o]][bn];
                     if (rn.isZero()) continue;
                     any = true;
                     const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];

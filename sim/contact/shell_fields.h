@@ -22,17 +22,26 @@
 // momentum is unchanged except through pins. The contact particles' elasticity and
 // return mapping act as before, through the grid forces.
 //
-// Bulk materials share one field (sand on snow stays single-field MPM), as do the folds
-// of one shell (self-contact). Nodes on colliders or walls, and nodes where the bulk
-// share is too small to separate from round-off (under 1e-3 of the mass), keep one
-// velocity.
+// Bulk materials share one field (sand on snow stays single-field MPM). The folds of one
+// shell get two fields where they meet (shell_folds.cpp): at a node whose stencil holds
+// two layers of it, its control points are split by the node's height over their tangent
+// planes, and the two classes meet by the same rule as two shells, with the shell's c_F.
+// Without the split a fold slid over the rest of its cloth at a quarter of Coulomb's
+// acceleration; the shell guard (shell_guard.h) stays the backstop against crossing where
+// a crumple has more than two layers at a node. Nodes on colliders or walls, and nodes
+// where the bulk share is too small to separate from round-off (under 1e-3 of the mass),
+// keep one velocity.
 #pragma once
 #include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
 #include "sim/contact/shell_transfer.h"
+#include "sim/core/types.h"
 #include "sim/mpm/particles.h"
 #include "sim/mpm/sparse_grid.h"
 
@@ -44,9 +53,9 @@ class ShellFields {
   /// a wall).
   using SkipFn = std::function<bool(const Vec3i& node)>;
 
-  /// Grid geometry, the number of grid shells and whether there is bulk material: fields
-  /// are kept when there are two bodies or more (two shells, or a shell and bulk).
-  void setup(const SparseGrid& grid, std::size_t num_shells, bool bulk);
+  /// Grid geometry and the number of grid shells: fields are kept whenever there is one
+  /// (bulk material, other shells and the shell's own folds are the other bodies).
+  void setup(const SparseGrid& grid, std::size_t num_shells);
   bool active() const { return active_; }
 
   /// Right after the combined P2G (the combined grid holds mass and momentum): each
@@ -72,21 +81,84 @@ class ShellFields {
     Real N[3];  ///< sum of w m n_j, n_j the shell's own (oriented) normal
     Real o[3];  ///< sum of w m (x_j - x_node) / dx; the centroid offset after p2g()
     Real held;  ///< mass of fully pinned control points
+    /// Least and greatest height of the node over the control points' tangent planes, in
+    /// cells, along their normals aligned to kAlign (fold_height): two layers differ.
+    Real hmin, hmax;
+    /// Zero sums, empty height range.
+    static void clear(Node* d, std::size_t count) {
+      std::memset(static_cast<void*>(d), 0, count * sizeof(Node));
+      for (std::size_t k = 0; k < count; ++k) {
+        d[k].hmin = std::numeric_limits<Real>::max();
+        d[k].hmax = std::numeric_limits<Real>::lowest();
+      }
+    }
+    void operator+=(const Node& b) {
+      m += b.m;
+      held += b.held;
+      for (int a = 0; a < 3; ++a) {
+        p[a] += b.p[a];
+        n[a] += b.n[a];
+        N[a] += b.N[a];
+        o[a] += b.o[a];
+      }
+      hmin = std::min(hmin, b.hmin);
+      hmax = std::max(hmax, b.hmax);
+    }
   };
   /// Bulk mass and first moment sum w m (x_p - x_node) / dx at a node.
   struct Moment {
     Real m;
     Real o[3];
   };
+  struct Classes {
+    Node c[2];  ///< fold_height below and above the cut
+  };
+  /// A fixed direction no flat layer of a usual scene is perpendicular to (normals along
+  /// the axes, or tilted in one plane, all have a clear sign against it).
+  static inline const Vec3 kAlign = Vec3(Real(0.8), Real(0.5), Real(0.33)).normalized();
+  /// The second class of a shell's control points on the grid blocks where it folds.
+  /// The second class of a shell's control points on the grid blocks where it folds.
+  struct FoldBlock {
+    std::array<std::uint8_t, kBlockNodes> split;  ///< 1: the node has two classes
+    std::array<Real, kBlockNodes> cut;            ///< class 1: fold_height >= cut
+    std::array<Node, kBlockNodes> second;  ///< class 1
+    std::array<Vec3, kBlockNodes> r;       ///< its velocity relative to the node
+  };
+  /// The height of node offset (i, j, k) over the tangent plane of a control point with
+  /// unit normal n at grid coordinate fx within its stencil, in cells, along n turned to
+  /// kAlign's side: every point of one flat layer gives the same, whatever the layer's
+  /// orientation, and two layers differ by their distance.
+  static Real fold_height(const Vec3& n, const Vec3& fx, int i, int j, int k) {
+    const Real h = n.dot(Vec3(Real(i), Real(j), Real(k)) - fx);
+    return n.dot(kAlign) >= 0 ? h : -h;
+  }
+  static bool is_split(const FoldBlock& fb, int bn) { return fb.split[bn] != 0; }
   struct Field {
     SparseGrid grid;  ///< binning of this shell's control points (its nodes unused)
     std::vector<std::array<Node, kPadNodes>> buf;
-    std::vector<std::array<Node, kBlockNodes>> nodes;
+    std::vector<std::array<Node, kBlockNodes>> nodes;  ///< the shell, or its first class
     std::vector<std::array<Vec3, kBlockNodes>> r;  ///< velocity relative to the node
     std::vector<Vec3> x0;                          ///< control points at p2g time
     std::vector<Vec3> normal;                      ///< control-point unit normals
+    std::vector<int> fold;           ///< per grid block: index into folds, -1: no fold
+    std::vector<FoldBlock> folds;    ///< grid blocks where the shell folds, in block order
+    std::vector<int> touched;        ///< per particle block: index into the fold buffers
+    std::vector<std::array<Classes, kPadNodes>> class_buf;
+  };
+  /// One control point's share of its 27 stencil nodes in a field's P2G.
+  struct PointShare {
+    Real m, mh;  ///< mass; its fully pinned part
+    Real align;  ///< +1 or -1: n turned to kAlign's side
+    Vec3 fx, base, n;
+    Mat3 A;
+    PointShare(const GridShell& gs, const Vec3& n, const Vec3& fx, std::uint32_t j, Real dx, Real dt);
+    /// Adds the weight-w share at stencil offset (i, j, k) to d.
+    void add(Node& d, Real w, int i, int j, int k) const;
   };
   void shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial);
+  /// Between the sums and their normalisation in shell_p2g: finds the nodes where F's
+  /// shell folds and splits its control points there into two classes (shell_folds.cpp).
+  void split_folds(Field& F, const GridShell& gs, Real dt, bool serial);
   /// Bulk mass centroids on the grid blocks where shells have fields.
   void bulk_moments(const SparseGrid& combined, const ParticleSet& bulk, std::uint32_t first_bulk,
                     bool serial);

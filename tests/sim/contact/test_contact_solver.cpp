@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sim/solver/solver.h"
+#include "tests/support/least_squares.h"
 #include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;
@@ -279,19 +280,6 @@ std::vector<double> slide(Solver& solver, std::size_t i, double th, const std::v
   return out;
 }
 
-// Least-squares acceleration of s(t) = a0 + a1 t + a/2 t^2.
-double fit_acceleration(const std::vector<double>& t, const std::vector<double>& s) {
-  Eigen::MatrixXd A(t.size(), 3);
-  Eigen::VectorXd b(t.size());
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    A(k, 0) = 1;
-    A(k, 1) = t[k];
-    A(k, 2) = 0.5 * t[k] * t[k];
-    b[k] = s[k];
-  }
-  return A.colPivHouseholderQr().solve(b)[2];
-}
-
 // The top sheet is `size` m square with `res` cells a side (0.16 m, 8: 8 grid cells).
 Scene incline_scene(double th_deg, bool on_sheet, double mu, double gap0 = 0.03, double size = 0.16,
                     int res = 8) {
@@ -344,7 +332,7 @@ Slide run_incline(double th_deg, bool on_sheet, double mu, double gap0, double s
   Scene s = incline_scene(th_deg, on_sheet, mu, gap0, size, res);
   Solver solver(s);
   const auto d = slide(solver, s.shells.size() - 1, th, times);
-  return {fit_acceleration(times, d), d.back() - d.front(),
+  return {test::fit_acceleration(times, d), d.back() - d.front(),
           9.81 * (std::sin(th) - mu * std::cos(th))};
 }
 

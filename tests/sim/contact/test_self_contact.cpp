@@ -1,0 +1,108 @@
+// Self-contact of one shell: two layers of the same cloth on either side of a grid node
+// get two velocity fields (sim/contact/shell_folds.cpp), so a fold slides over the rest of
+// its cloth at Coulomb's law with the shell's c_F instead of sharing its velocity.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "sim/shell/procedural_mesh.h"
+#include "sim/solver/solver.h"
+#include "tests/support/least_squares.h"
+#include "tests/support/shell_fixtures.h"
+
+using namespace shellmpm;
+
+namespace {
+
+constexpr int kBaseCells = 40;  // the cloth's pinned part: 0.8 m, 40 x 40 quads
+constexpr int kBasePoints = (kBaseCells + 1) * (kBaseCells + 1);
+
+// One shell of two parts on a slope of th_deg: a pinned 0.8 m cloth and a free 0.16 m
+// piece of it gap0 above, wound the same way (a stacked layer, as in a rolled sheet) or
+// the other way (a layer folded over, its normal facing the cloth).
+Scene fold_on_slope(double th_deg, double mu, bool folded, double gap0 = 0.07) {
+  Scene s;
+  s.path = "test";
+  s.shot.dx = 0.02;
+  s.shot.cfl = 0.5;
+  s.shot.fps = 48;
+  s.shot.domain_min = Vec3d(-1, -1, -1);
+  s.shot.domain_max = Vec3d(1, 1, 1);
+  ShellMaterialDesc m = test::cloth_material();
+  m.friction = mu;
+  s.shell_materials.push_back(m);
+  ShellMesh mesh = make_sheet(0.8, 0.8, kBaseCells, kBaseCells);
+  const ShellMesh top = make_sheet(0.16, 0.16, 8, 8);
+  const int off = static_cast<int>(mesh.vertices.size());
+  for (std::size_t k = 0; k < top.vertices.size(); ++k) {
+    mesh.vertices.push_back(top.vertices[k] + Vec3d(-0.2, gap0, 0));
+    mesh.uvs.push_back(top.uvs[k]);
+  }
+  for (Eigen::Vector3i t : top.triangles) {
+    if (folded) std::swap(t[1], t[2]);
+    mesh.triangles.push_back(t + Eigen::Vector3i::Constant(off));
+  }
+  ShellDesc d;
+  d.name = "cloth";
+  d.kind = ShellDesc::Kind::Mesh;
+  d.mesh = std::make_shared<ShellMesh>(std::move(mesh));
+  d.rotate_deg = Vec3d(0, 0, -th_deg);
+  d.contact = ShellDesc::Contact::On;
+  PinDesc base;
+  for (int i = 0; i < kBasePoints; ++i) base.indices.push_back(i);
+  d.pins.push_back(base);
+  s.shells.push_back(d);
+  return s;
+}
+
+struct Slide {
+  double a;          ///< fitted acceleration of the free part down the slope [m/s^2]
+  double travelled;  ///< from t = 0.1 s to 0.4 s [m]
+  double a_ref;      ///< Coulomb: g (sin - c_F cos) (negative: it should stick)
+};
+
+Slide run_fold(double th_deg, double mu, bool folded) {
+  const Scene s = fold_on_slope(th_deg, mu, folded);
+  Solver solver(s);
+  REQUIRE(solver.shell_on_grid(0));
+  const double th = th_deg * M_PI / 180;
+  const Vec3d t(std::cos(th), -std::sin(th), 0);
+  std::vector<double> times, d;
+  for (int k = 0; k <= 30; ++k) times.push_back(0.1 + 0.01 * k);
+  for (double tt : times) {
+    solver.advance_to(tt);
+    const ShellObject& sh = *solver.shells()[0];
+    Vec3d c = Vec3d::Zero();
+    double m = 0;
+    for (std::size_t j = kBasePoints; j < sh.size(); ++j) {
+      c += sh.mass[j] * sh.x[j].cast<double>();
+      m += sh.mass[j];
+    }
+    d.push_back((c / m).dot(t));
+  }
+  return {test::fit_acceleration(times, d), d.back() - d.front(),
+          9.81 * (std::sin(th) - mu * std::cos(th))};
+}
+
+}  // namespace
+
+TEST_CASE("a fold slides over its own pinned cloth at g (sin - c_F cos), stacked or folded over",
+          "[contact]") {
+  // With one velocity per node for the whole shell the piece did not slide at all.
+  for (bool folded : {false, true}) {
+    const Slide r = run_fold(30, 0.3, folded);
+    INFO((folded ? "folded over" : "stacked") << ": acceleration " << r.a << " m/s^2, Coulomb "
+                                              << r.a_ref << ", travelled " << r.travelled << " m");
+    CHECK(r.a == Approx(r.a_ref).epsilon(0.05));
+  }
+}
+
+TEST_CASE("a fold of one cloth sticks below the friction angle and slides freely without friction",
+          "[contact][slow]") {
+  const Slide stick = run_fold(10, 0.3, true);
+  INFO("10 deg, c_F 0.3: acceleration " << stick.a << ", travelled " << stick.travelled << " m");
+  CHECK(std::abs(stick.travelled) < 0.01);
+  const double g_sin = 9.81 * std::sin(30 * M_PI / 180);
+  const Slide free = run_fold(30, 0.0, true);
+  INFO("30 deg, c_F 0: acceleration " << free.a << " m/s^2, g sin " << g_sin);
+  CHECK(free.a == Approx(g_sin).epsilon(0.05));
+}
