@@ -168,6 +168,7 @@ std::vector<KeySpec> build_schema() {
       Spec("shot.threads", T::Int).def("0").ge(0),
       Spec("shot.transfer", T::Enum).def("apic").choices({"apic", "mls"}),
       Spec("shot.shell_velocities", T::Enum).def("per_shell").choices({"per_shell", "shared"}),
+      Spec("shot.fold_fields", T::Bool).def("false"),
       Spec("shot.shell_guard", T::Bool).def("true"),
       Spec("shot.shell_guard_gap", T::Number)
           .def("0")
@@ -1628,6 +1629,7 @@ void read_shot(const DocNode& node, ShotSettings& shot) {
   shot.threads = r.int32("threads");
   shot.transfer = r.choice("transfer");
   shot.shared_shell_velocity = r.choice("shell_velocities") == "shared";
+  shot.fold_fields = r.boolean("fold_fields");
   shot.shell_guard = r.boolean("shell_guard");
   shot.shell_guard_gap = r.number("shell_guard_gap");
   shot.units = r.string("units");

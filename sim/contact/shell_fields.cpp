@@ -14,9 +14,10 @@ constexpr Real kBulkMin = Real(1e-3);    ///< bulk share of a node's mass that g
 constexpr Real kShellOnly = Real(1e-4);  ///< below this bulk share the node is shells only
 }  // namespace
 
-void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells) {
+void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bulk, bool folds) {
   fields_.clear();
-  active_ = num_shells >= 1;
+  folds_ = folds;
+  active_ = num_shells >= 2 || (num_shells >= 1 && (bulk || folds));
   if (!active_) return;
   fields_.resize(num_shells);
   for (Field& f : fields_) f.grid.setup(grid.dx(), grid.origin());
@@ -108,7 +109,12 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
         }
       },
       serial);
-  split_folds(F, gs, dt, serial);
+  if (folds_) {
+    split_folds(F, gs, dt, serial);
+  } else {
+    F.fold.assign(F.grid.num_grid_blocks(), -1);
+    F.folds.clear();
+  }
   // Momentum to velocity, first moment to centroid offset.
   const auto normalise = [](Node& d) {
     if (d.m > 0)

@@ -53,9 +53,10 @@ class ShellFields {
   /// a wall).
   using SkipFn = std::function<bool(const Vec3i& node)>;
 
-  /// Grid geometry and the number of grid shells: fields are kept whenever there is one
-  /// (bulk material, other shells and the shell's own folds are the other bodies).
-  void setup(const SparseGrid& grid, std::size_t num_shells);
+  /// Grid geometry, the number of grid shells, whether there is bulk material and whether
+  /// a shell's folds are bodies of their own (shot.fold_fields): fields are kept when
+  /// there are two bodies or more (two shells, a shell and bulk, or a folding shell).
+  void setup(const SparseGrid& grid, std::size_t num_shells, bool bulk, bool folds);
   bool active() const { return active_; }
 
   /// Right after the combined P2G (the combined grid holds mass and momentum): each
@@ -163,6 +164,7 @@ class ShellFields {
   void bulk_moments(const SparseGrid& combined, const ParticleSet& bulk, std::uint32_t first_bulk,
                     bool serial);
   bool active_ = false;
+  bool folds_ = false;  ///< split_folds on
   std::vector<Field> fields_;
   std::vector<Real> friction_;  ///< per shell: c_F against bulk material
   // Per combined grid block: the fields' block indices (-1: absent), the bulk field's

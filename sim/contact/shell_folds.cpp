@@ -27,7 +27,7 @@ namespace {
 /// Least spread of a node's heights over the tangent planes, in cells, for a split: two
 /// layers resting on each other lie 1-2 cells apart; one flat layer spreads by round-off,
 /// one bent to a radius of R cells by about 2.25 / R.
-constexpr Real kMinRange = Real(0.5);
+constexpr Real kMinRange = Real(1.0);
 }  // namespace
 
 void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool serial) {

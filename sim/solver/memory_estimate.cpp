@@ -315,11 +315,12 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
     n.particle_blocks += pb;
     n.grid_blocks += 2.2 * pb;
   }
-  // Per-shell velocity fields (shot.shell_velocities: per_shell) for every grid shell (its
-  // folds are bodies too): each bins its control points into its own grid and keeps 6^3
+  // Per-shell velocity fields (shot.shell_velocities: per_shell) when two bodies share the
+  // grid (two shells, a shell and bulk, or a shell's folds): each bins its control points into its own grid and keeps 6^3
   // buffers and 4^3 nodes of 14 Reals; the combined grid keeps the bulk moments. Fold
   // blocks are transient and few (a crumple's folds cover a fraction of its blocks).
-  const bool fields = fields_wanted && grid_shells >= 1;
+  const bool fields = fields_wanted && (grid_shells >= 2 || (grid_shells >= 1 && (shot.fold_fields ||
+                                                                                   !scene.sources.empty())));
   if (fields) {
     for (double pb : shell_pblocks) {
       const double gb = 2.2 * pb;

@@ -68,7 +68,8 @@ void Solver::setup_contact() {
     c_.grid_shells.push_back(std::move(g));
   }
   c_.shell_table.build(c_.grid_shells);
-  c_.shell_fields.setup(c_.grid, c_.scene.shot.shared_shell_velocity ? 0 : c_.grid_shells.size());
+  c_.shell_fields.setup(c_.grid, c_.scene.shot.shared_shell_velocity ? 0 : c_.grid_shells.size(),
+                        !c_.scene.sources.empty(), c_.scene.shot.fold_fields);
 }
 
 std::vector<std::string> Solver::stage_names() const {
