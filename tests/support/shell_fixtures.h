@@ -15,4 +15,16 @@ inline ShellMaterialDesc cloth_material() {
   return m;
 }
 
+/// A scene for contact tests: grid spacing dx, CFL 0.5, 48 fps, the domain [-1, 1]^3.
+inline Scene contact_test_scene(double dx) {
+  Scene s;
+  s.path = "test";
+  s.shot.dx = dx;
+  s.shot.cfl = 0.5;
+  s.shot.fps = 48;
+  s.shot.domain_min = Vec3d(-1, -1, -1);
+  s.shot.domain_max = Vec3d(1, 1, 1);
+  return s;
+}
+
 }  // namespace shellmpm::test

@@ -42,13 +42,7 @@ ShellDesc sheet(const std::string& name, double size, int res, const Vec3d& at) 
 }
 
 Scene contact_scene(double dx) {
-  Scene s;
-  s.path = "test";
-  s.shot.dx = dx;
-  s.shot.cfl = 0.5;
-  s.shot.fps = 48;
-  s.shot.domain_min = Vec3d(-1, -1, -1);
-  s.shot.domain_max = Vec3d(1, 1, 1);
+  Scene s = test::contact_test_scene(dx);
   s.shell_materials.push_back(cloth());
   return s;
 }
@@ -285,13 +279,7 @@ Scene incline_scene(double th_deg, bool on_sheet, double mu, double gap0 = 0.03,
                     int res = 8) {
   const double th = th_deg * M_PI / 180;
   const Vec3d n(std::sin(th), std::cos(th), 0);
-  Scene s;
-  s.path = "test";
-  s.shot.dx = 0.02;
-  s.shot.cfl = 0.5;
-  s.shot.fps = 48;
-  s.shot.domain_min = Vec3d(-1, -1, -1);
-  s.shot.domain_max = Vec3d(1, 1, 1);
+  Scene s = test::contact_test_scene(0.02);
   s.shell_materials.push_back(cloth(mu));
   if (on_sheet) {
     ShellDesc base = sheet("base", 0.8, 40, Vec3d::Zero());

@@ -21,13 +21,7 @@ constexpr int kBasePoints = (kBaseCells + 1) * (kBaseCells + 1);
 // the other way (a layer folded over, its normal facing the cloth).
 Scene fold_on_slope(double th_deg, double mu, bool folded, bool fold_fields = true,
                     double gap0 = 0.07) {
-  Scene s;
-  s.path = "test";
-  s.shot.dx = 0.02;
-  s.shot.cfl = 0.5;
-  s.shot.fps = 48;
-  s.shot.domain_min = Vec3d(-1, -1, -1);
-  s.shot.domain_max = Vec3d(1, 1, 1);
+  Scene s = test::contact_test_scene(0.02);
   s.shot.fold_fields = fold_fields;
   ShellMaterialDesc m = test::cloth_material();
   m.friction = mu;
