@@ -11,7 +11,7 @@
 // face each other counts like stacked turns). P2G keeps each node's least and greatest
 // height; where they differ by kMinRange cells or more, the points are split at the
 // midpoint into two classes, and each becomes a body of its own for Bardenhagen's rule.
-// A single layer curved to a radius under about three cells also spans that range and is
+// A single layer curved to a radius under about two cells also spans that range and is
 // split between its inner and outer part: harmless, the parts are held together by the
 // shell's own forces, and where they do not approach they keep their own velocities as
 // a finer transfer would. Everything here runs only on the particle blocks next to split
