@@ -24,8 +24,9 @@ void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bul
 }
 
 ShellFields::PointShare::PointShare(const GridShell& gs, const Vec3& nj, const Vec3& f,
-                                   std::uint32_t j, Real dx, Real dt)
-    : m(gs.shell->mass[j]),
+                                   std::uint32_t j, Real dx, Real dt, bool with_heights)
+    : heights(with_heights),
+      m(gs.shell->mass[j]),
       mh(gs.held[j] == 7 ? m : Real(0)),
       align(nj.dot(kAlign) >= 0 ? Real(1) : Real(-1)),
       fx(f),
@@ -49,7 +50,7 @@ void ShellFields::PointShare::add(Node& d, Real w, int i, int j, int k) const {
     d.N[a] += w * m * n[a];
     d.o[a] += w * m * off[a];
   }
-  if (w > 0) {
+  if (heights && w > 0) {
     const Real h = align * side;  // fold_height
     d.hmin = std::min(d.hmin, h);
     d.hmax = std::max(d.hmax, h);
@@ -85,7 +86,8 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
           for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
             const std::uint32_t j = F.grid.order[q];
             const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
-            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt);
+            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt,
+                               folds_);
             const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
             for (int i = 0; i < 3; ++i)
               for (int jj = 0; jj < 3; ++jj)
@@ -96,6 +98,15 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
         }
       },
       serial);
+  // Momentum to velocity, first moment to centroid offset: right after the sums, or,
+  // with fold fields, after split_folds has used the sums.
+  const auto normalise = [](Node& d) {
+    if (d.m > 0)
+      for (int a = 0; a < 3; ++a) {
+        d.p[a] /= d.m;
+        d.o[a] /= d.m;
+      }
+  };
   parallel_for(
       ng, 4,
       [&](std::size_t gb, std::size_t ge) {
@@ -106,23 +117,17 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
           F.grid.for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
             nodes[dn] += F.buf[src][sn];
           });
+          if (!folds_)
+            for (Node& d : nodes) normalise(d);
         }
       },
       serial);
-  if (folds_) {
-    split_folds(F, gs, dt, serial);
-  } else {
-    F.fold.assign(F.grid.num_grid_blocks(), -1);
+  if (!folds_) {
+    F.fold.assign(ng, -1);
     F.folds.clear();
+    return;
   }
-  // Momentum to velocity, first moment to centroid offset.
-  const auto normalise = [](Node& d) {
-    if (d.m > 0)
-      for (int a = 0; a < 3; ++a) {
-        d.p[a] /= d.m;
-        d.o[a] /= d.m;
-      }
-  };
+  split_folds(F, gs, dt, serial);
   parallel_for(
       ng, 16,
       [&](std::size_t gb, std::size_t ge) {
@@ -381,6 +386,7 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
     GridShell& gs = shells[s];
     ShellObject& sh = *gs.shell;
     const Real c_scale = Real(4) / static_cast<Real>(F.grid.dx());
+    const bool folded = !F.folds.empty();
     parallel_for(
         F.grid.num_particle_blocks(), 1,
         [&](std::size_t bb, std::size_t be) {
@@ -401,7 +407,7 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
                     const int px = lx + i, py = ly + jj, pz = lz + k;
                     const int o = (px >> 2) * 4 + (py >> 2) * 2 + (pz >> 2);
                     const int bn = block_node(px & 3, py & 3, pz & 3);
-                    const int fi = F.fold[nbr[o]];
+                    const int fi = folded ? F.fold[nbr[o]] : -1;
                     // Where the shell folds, the control point reads its own class.
                     const bool second = fi >= 0 && is_split(F.folds[fi], bn) &&
                                         fold_height(F.normal[j], fx, i, jj, k) >= F.folds[fi].cut[bn];

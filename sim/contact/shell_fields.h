@@ -148,11 +148,13 @@ class ShellFields {
   };
   /// One control point's share of its 27 stencil nodes in a field's P2G.
   struct PointShare {
-    Real m, mh;  ///< mass; its fully pinned part
+    bool heights;  ///< keep the nodes' height range (fold fields on)
+    Real m, mh;    ///< mass; its fully pinned part
     Real align;  ///< +1 or -1: n turned to kAlign's side
     Vec3 fx, base, n;
     Mat3 A;
-    PointShare(const GridShell& gs, const Vec3& n, const Vec3& fx, std::uint32_t j, Real dx, Real dt);
+    PointShare(const GridShell& gs, const Vec3& n, const Vec3& fx, std::uint32_t j, Real dx, Real dt,
+               bool with_heights);
     /// Adds the weight-w share at stencil offset (i, j, k) to d.
     void add(Node& d, Real w, int i, int j, int k) const;
   };

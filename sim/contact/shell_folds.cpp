@@ -82,7 +82,8 @@ void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool seria
           for (std::uint32_t q = G.pblock_start[b]; q < G.pblock_start[b + 1]; ++q) {
             const std::uint32_t j = G.order[q];
             const QuadraticWeights W(G.grid_coord(sh.x[j]));
-            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt);
+            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt,
+                               true);
             const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
             for (int i = 0; i < 3; ++i)
               for (int jj = 0; jj < 3; ++jj)

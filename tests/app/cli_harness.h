@@ -28,6 +28,16 @@ output:
   directory: OUT
 )";
 
+/// kTinyJellyScene with its last frame set to `last_frame` and its output directory to
+/// `out`, followed by `extra` (more top-level sections).
+inline std::string tiny_jelly_scene(int last_frame, const std::string& out,
+                                    const std::string& extra = "") {
+  std::string s = kTinyJellyScene;
+  s.replace(s.find("frames: [1, 2]"), 14, "frames: [1, " + std::to_string(last_frame) + "]");
+  s.replace(s.find("directory: OUT"), 14, "directory: " + out);
+  return s + extra;
+}
+
 struct CmdResult {
   int code = -1;
   std::string output;  ///< stdout and stderr together

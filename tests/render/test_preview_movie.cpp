@@ -16,21 +16,8 @@ namespace {
 
 // Four frames of a small elastic box; an odd preview size so that ffmpeg's pad to even
 // dimensions (yuv420p) is exercised: 65x49 -> 66x50.
-const char* kScene = R"(version: 1
-shot:
-  frames: [1, 4]
-  fps: 240
-  dx: 0.05
-  domain: {min: [-0.5, 0, -0.5], max: [0.5, 1, 0.5]}
-materials:
-  - {name: jelly, type: elastic, youngs_modulus: 1.0e4, density: 1000}
-sources:
-  - {material: jelly, shape: {type: box, min: [-0.1, 0.3, -0.1], max: [0.1, 0.5, 0.1]}}
-output:
-  directory: out/never_used
-render:
-  size: [65, 49]
-)";
+const std::string kScene =
+    tiny_jelly_scene(4, "out/never_used", "render:\n  size: [65, 49]\n");
 
 /// The value of `key=` in ffprobe's "default" output, or "" when absent.
 std::string probe_value(const std::string& probe, const std::string& key) {
