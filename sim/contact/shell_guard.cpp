@@ -358,15 +358,46 @@ std::size_t ShellGuard::impact_zones(double tol) {
   return zoned;
 }
 
-ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBulk& bulk, double dt) {
+ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBulk& bulk,
+                                  double dt) {
+  std::vector<std::vector<Vec3>> start(shells.size());
+  for (std::size_t s = 0; s < shells.size(); ++s) {
+    const ShellObject& sh = *shells[s].shell;
+    start[s].resize(sh.size());
+    for (std::size_t j = 0; j < sh.size(); ++j)
+      start[s][j] = sh.x[j] - static_cast<Real>(dt) * sh.v[j];
+  }
+  return apply(shells, start, bulk, dt);
+}
+
+ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
+                                  const std::vector<std::vector<Vec3>>& start, const GuardBulk& bulk,
+                                  double dt) {
   ShellGuardStats st;
   if (meshes_.empty() || !(dt > 0)) return st;
   const std::size_t np = point_offset_.back(), nv = vertex_offset_.back();
+  // Control points: start-of-step positions, and the velocity that takes them to where
+  // they are now ((x - x^n) / dt: G2P's velocity, plus a collider's projection where one
+  // moved the point), which the constraints act on.
+  v_.resize(np);
+  v_end_.resize(np);
+  inv_mass_.resize(np);
+  x0_.resize(np);
+  double vmax = 0;
+  for (std::size_t s = 0; s < shells.size(); ++s) {
+    const ShellObject& sh = *shells[s].shell;
+    for (std::size_t j = 0; j < sh.size(); ++j) {
+      const std::size_t g = point_offset_[s] + j;
+      x0_[g] = to_d(start[s][j]);
+      v_[g] = v_end_[g] = (to_d(sh.x[j]) - x0_[g]) / dt;
+      vmax = std::max(vmax, v_[g].norm());
+      const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
+      const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
+      for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
+    }
+  }
   // Speed bounds: the limit vertices are convex combinations of the control points (Loop
   // limit weights are positive), so the largest control-point speed bounds theirs.
-  double vmax = 0;
-  for (const GridShell& g : shells)
-    for (const Vec3& v : g.shell->v) vmax = std::max(vmax, static_cast<double>(v.norm()));
   ParticleSet* const ps = bulk.particles;
   const std::size_t nb = ps ? ps->size() : 0;
   double vbulk = 0;
@@ -387,21 +418,6 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
   if (!shell_rebuild && !bulk_rebuild && vt_cand_.empty() && ee_cand_.empty() &&
       bt_cand_.empty())
     return st;  // nothing near, and the lists still hold
-  // Control velocities, inverse masses and start-of-step positions.
-  v_.resize(np);
-  inv_mass_.resize(np);
-  x0_.resize(np);
-  for (std::size_t s = 0; s < shells.size(); ++s) {
-    const ShellObject& sh = *shells[s].shell;
-    for (std::size_t j = 0; j < sh.size(); ++j) {
-      const std::size_t g = point_offset_[s] + j;
-      v_[g] = to_d(sh.v[j]);
-      x0_[g] = to_d(sh.x[j]) - dt * v_[g];
-      const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
-      const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
-      for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
-    }
-  }
   // Limit vertices at x^n.
   pos_.assign(nv, Vec3d::Zero());
   for (std::size_t s = 0; s < meshes_.size(); ++s) {
@@ -519,15 +535,16 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
   for (const Pair& p : pairs_)
     if (p.target - rate(p) > tol) ++st.unresolved;
   if (st.impulses == 0 && st.zoned == 0) return st;
-  // Write back: changed velocities, and x^{n+1} = x^n + dt v moves with them.
+  // Write back: the change of each velocity, and the position moves by dt times it.
   for (std::size_t s = 0; s < shells.size(); ++s) {
     ShellObject& sh = *shells[s].shell;
     for (std::size_t j = 0; j < sh.size(); ++j) {
-      const Vec3 vn = v_[point_offset_[s] + j].cast<Real>();
+      const std::size_t g = point_offset_[s] + j;
       for (int a = 0; a < 3; ++a) {
-        if (vn[a] == sh.v[j][a]) continue;
-        sh.x[j][a] += static_cast<Real>(dt) * (vn[a] - sh.v[j][a]);
-        sh.v[j][a] = vn[a];
+        const double dv = v_[g][a] - v_end_[g][a];
+        if (dv == 0) continue;
+        sh.x[j][a] += static_cast<Real>(dt * dv);
+        sh.v[j][a] += static_cast<Real>(dv);
       }
     }
   }

@@ -10,11 +10,13 @@
 // contact and friction for cloth animation"): it never replaces the grid's contact and
 // friction, it only stops the last approach closer than a gap the grid would not hold.
 //
-// What it does, once per step after G2P (control points have v^{n+1} and
-// x^{n+1} = x^n + dt v^{n+1}):
+// What it does, once per step after G2P and the colliders' projection (control points
+// have moved from x^n, which G2P recorded, to x^{n+1}):
 // - Geometry at the start of the step: the limit mesh at refine 0 (the Loop limit
 //   positions of the control points, the surface the integrity monitor judges), built
-//   from x^n = x^{n+1} - dt v^{n+1}; limit velocities u = S v with the same sparse map S.
+//   from x^n; the unknowns are the velocities v = (x^{n+1} - x^n) / dt (G2P's, plus the
+//   projection's push where a collider moved a point), limit velocities u = S v with the
+//   same sparse map S.
 // - Bulk particles are points of the same kind: a bulk particle closer than the gap to a
 //   limit triangle is a pair like a limit vertex (its mass from volume and density).
 // - Proximity pairs at x^n within gap + reach (reach = twice the largest limit speed
@@ -33,7 +35,9 @@
 //   energy) and sum to zero over the control points (S rows and barycentric weights
 //   both sum to 1), so momentum is conserved except at pins.
 // - Control points whose velocity changed move by dt (v_new - v_old), so
-//   x^{n+1} = x^n + dt v_new still holds.
+//   x^{n+1} = x^n + dt v_new still holds. A projection after the guard would move points
+//   it had just held apart (a crushed crumple's top layer pressed through the one under
+//   it), hence its place after the colliders.
 // Pairs still violated after the sweep cap go to impact zones (Provot 1997, Bridson et
 // al. 2002): the points of connected violated pairs move with their mean velocity, so
 // those pairs stop closing; momentum is kept, energy only lost. What even that cannot
@@ -72,7 +76,11 @@ class ShellGuard {
   /// The shells' topology is fixed from here on. gap [m] > 0; serial: no threads.
   void setup(const std::vector<GridShell>& shells, double gap, bool serial = false);
   double gap() const { return gap_; }
-  /// One pass after G2P (see the file comment): changes v and x of control points.
+  /// One pass after G2P and the colliders' projection (see the file comment): changes v
+  /// and x of control points. start: each shell's control points at x^n.
+  ShellGuardStats apply(std::vector<GridShell>& shells, const std::vector<std::vector<Vec3>>& start,
+                        const GuardBulk& bulk, double dt);
+  /// The same, with x^n = x - dt v (nothing moved the points since G2P).
   ShellGuardStats apply(std::vector<GridShell>& shells, const GuardBulk& bulk, double dt);
 
   /// Gauss-Seidel sweeps at most per pass.
@@ -149,6 +157,7 @@ class ShellGuard {
   // Per pass (kept to reuse their memory).
   std::vector<Vec3d> pos_;               ///< limit vertices of all shells at x^n
   std::vector<Vec3d> x0_;                ///< control points at x^n
+  std::vector<Vec3d> v_end_;             ///< (x - x^n) / dt before the guard
   std::vector<Vec3d> v_;                 ///< control velocities (double) being corrected
   std::vector<Vec3d> inv_mass_;          ///< per control point and component
   std::vector<Eigen::Vector3i> all_tris_;

@@ -67,6 +67,10 @@ struct StepContext {
   ShellFields shell_fields;        ///< per-shell velocities on shared nodes: p2g, g2p
   ShellPointTable shell_table;     ///< grid shells' points in the combined binning
   std::vector<Vec3> shell_points;  ///< written by bin, read by p2g and g2p
+  /// The grid shells' control points at the start of the step (x^n): written by g2p
+  /// before it moves them, read by shell_guard, which runs after the colliders have
+  /// projected points out (so x - dt v is not x^n for every point any more).
+  std::vector<std::vector<Vec3>> shell_x_start;
 
   // Accumulated results (checkpointed): friction writes contact_step and friction_work,
   // denting writes plastic_work.

@@ -15,6 +15,10 @@ void G2pStage::run(StepContext& c) {
     tp.others = [&c, dt](std::size_t b, GridNode* buf) {
       shell_g2p_block(c.grid, c.shell_table, c.grid_shells, dt, b, buf);
     };
+  if (c.scene.shot.shell_guard) {
+    c.shell_x_start.resize(c.grid_shells.size());
+    for (std::size_t s = 0; s < c.grid_shells.size(); ++s) c.shell_x_start[s] = c.grid_shells[s].shell->x;
+  }
   const bool fields = c.shell_fields.active();
   if (fields)
     c.shell_fields.before_g2p(

@@ -31,7 +31,7 @@ void ShellGuardStage::run(StepContext& c) {
     bulk.densities = &c.densities;
     bulk.epoch = c.particle_epoch;
   }
-  const ShellGuardStats st = guard_.apply(c.grid_shells, bulk, c.dt);
+  const ShellGuardStats st = guard_.apply(c.grid_shells, c.shell_x_start, bulk, c.dt);
   ShellGuardStats& f = c.guard_frame;
   f.pairs = std::max(f.pairs, st.pairs);
   f.impulses += st.impulses;

@@ -125,7 +125,7 @@ TEST_CASE("every registered stage is reachable, once, in one execution order", "
   add_ground(s);
   const Names all = stages_of(s);
   REQUIRE(all == Names{"shell_forces", "shell_update", "contact", "bin", "p2g", "grid",
-                       "contact_grid", "colliders", "g2p", "shell_guard", "collider_particles",
+                       "contact_grid", "colliders", "g2p", "collider_particles", "shell_guard",
                        "friction",
                        "plasticity", "denting", "emit"});
   REQUIRE(std::set<std::string>(all.begin(), all.end()).size() == all.size());
