@@ -168,7 +168,7 @@ std::vector<KeySpec> build_schema() {
       Spec("shot.threads", T::Int).def("0").ge(0),
       Spec("shot.transfer", T::Enum).def("apic").choices({"apic", "mls"}),
       Spec("shot.shell_velocities", T::Enum).def("per_shell").choices({"per_shell", "shared"}),
-      Spec("shot.fold_fields", T::Bool).def("false"),
+      Spec("shot.fold_fields", T::Bool).def("true"),
       Spec("shot.shell_guard", T::Bool).def("true"),
       Spec("shot.shell_guard_gap", T::Number)
           .def("0")

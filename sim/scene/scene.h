@@ -31,9 +31,8 @@ struct ShotSettings {
   bool shared_shell_velocity = false;
   /// True: where two layers of one shell meet at a node they get two velocities there
   /// (sim/contact/shell_folds.cpp), so a fold slides over its own cloth at Coulomb's law;
-  /// false: one (the fold drags). Off by default until a crushed crumple holds with it
-  /// (README, "Contact").
-  bool fold_fields = false;
+  /// false: one (the fold drags; cheaper for a lone shell).
+  bool fold_fields = true;
   /// The shell guard (sim/contact/shell_guard.h): stops contact shells from closing
   /// closer than shell_guard_gap where the grid cannot hold them apart.
   bool shell_guard = true;
