@@ -4,6 +4,7 @@
 #include "app/scene_loading.h"
 #include "io/available_memory.h"
 #include "sim/core/parallel.h"
+#include "sim/solver/shot_estimate.h"
 #include "sim/solver/solver.h"
 #include "sim/solver/stages/shell_guard.h"
 #include "sim/solver/step_limits.h"
@@ -49,38 +50,11 @@ void print_estimate(const RunMemory& mem, const AvailableMemory& avail) {
         format_bytes(need).c_str(), format_bytes(avail.bytes).c_str(), avail.source.c_str());
 }
 
-}  // namespace
-
-int check_command(const CommonArgs& a) {
-  LoadedScene ls = load_scene_for_cli(a, "", "");
-  const Scene& scene = ls.scene;
-  ThreadLimit limit(scene.shot.threads);
+/// Each shell's points, quadrature, stable step and contact, with a warning when its mesh
+/// spacing and dx are far apart.
+void print_shells(const Solver& solver) {
+  const Scene& scene = solver.scene();
   const ShotSettings& s = scene.shot;
-  std::printf("scene %s: valid\n", scene.path.c_str());
-  std::printf("frames %d-%d at %g fps, dx %g m, domain [%g %g %g]..[%g %g %g]\n", s.frame_start,
-              s.frame_end, s.fps, s.dx, s.domain_min.x(), s.domain_min.y(), s.domain_min.z(),
-              s.domain_max.x(), s.domain_max.y(), s.domain_max.z());
-  const RunMemory mem = estimate_memory(ls);
-  const AvailableMemory avail = available_memory();
-  print_estimate(mem, avail);
-  const double need = mem.peak - mem.baseline;
-  if (mem.peak > kCheckBuildLimit || (avail.known && need > 0.5 * avail.bytes)) {
-    std::printf(
-        "note: check does not build a shot this large (over %s, or over half the "
-        "available memory): its stages and time step are not estimated; `shellmpm "
-        "run` reports them\n",
-        format_bytes(kCheckBuildLimit).c_str());
-    return kExitOk;
-  }
-
-  Solver solver(scene);
-  std::string stages;
-  for (const std::string& n : solver.stage_names()) stages += (stages.empty() ? "" : ", ") + n;
-  std::printf("stages: %s\n", stages.empty() ? "(none: nothing to simulate)" : stages.c_str());
-  if (ShellGuardStage::needed(scene))
-    std::printf("shell guard: gap %g m (%s)\n", ShellGuardStage::gap(scene),
-                scene.shot.shell_guard_gap > 0 ? "shot.shell_guard_gap"
-                                               : "0.05 dx or the thickest contact shell");
   for (std::size_t si = 0; si < solver.shells().size(); ++si) {
     const auto& sh = solver.shells()[si];
     const ShellMaterialDesc& m = scene.shell_materials[sh->desc().material];
@@ -113,32 +87,32 @@ int check_command(const CommonArgs& a) {
       std::printf("  contact: off (the shell moves on its own, without the grid)\n");
     }
   }
-  const double peak = mem.solver.counts.peak_particles();
-  // The step: the solver's bounds on the current particles and shells, plus the speeds
-  // and wave speeds (at rest) of what the sources are still to emit.
-  const std::vector<StepLimit> limits = step_limits(solver, /*upcoming=*/true);
-  const double dt = limits.front().dt;
-  const double steps = std::ceil(1.0 / s.fps / dt);
-  double harden = 1;
-  for (const ConstitutiveModel& m : solver.models())
-    harden = std::max(harden, static_cast<double>(std::sqrt(m.max_hardening())));
-  if (harden > 1.01)
+}
+
+/// The step, what sets it, and the time a frame costs; a warning when the step is below
+/// dt_min (the run would stop).
+void print_time(const Solver& solver, const RunMemory& mem) {
+  const ShotSettings& s = solver.scene().shot;
+  // The step and what a frame costs: the solver's bounds on the current particles and
+  // shells, plus the speeds and wave speeds (at rest) of what the sources are still to emit.
+  const ShotEstimate est =
+      estimate_shot(solver, mem.solver.counts.peak_particles(), ThreadLimit::active());
+  const std::vector<StepLimit>& limits = est.limits;
+  const double dt = est.dt;
+  if (est.snow_step_shrink > 1.01)
     std::printf("note: compressed snow hardens; its step can get up to %.1fx smaller than this\n",
-                harden);
-  // Throughput from bench/mpm_throughput on the reference machine, per thread.
-  constexpr double kParticleStepsPerSecondPerThread = 2.5e6;
-  const int threads = ThreadLimit::active();
-  const double sec = steps * peak / (kParticleStepsPerSecondPerThread * threads);
-  std::printf("time step: about %.3g s (%g substeps per frame)\n", dt, steps);
+                est.snow_step_shrink);
+  std::printf("time step: about %.3g s (%g substeps per frame)\n", dt, est.substeps_per_frame);
   // What sets it: the smallest bounds, smallest first.
   for (std::size_t i = 0; i < limits.size() && i < 3; ++i)
     std::printf("%s%s (%.2g s)\n",
                 i == 0 ? "time step limited by: " : "  then: ", limits[i].detail.c_str(),
                 limits[i].dt);
   std::printf(
-      "estimated time per frame at the peak: %.2f s on %d threads (at %.1fM "
-      "particle-steps/s/thread)\n",
-      sec, threads, kParticleStepsPerSecondPerThread / 1e6);
+      "estimated time per frame at the peak: %.2f s on %d threads (bulk particles %.2f s, "
+      "shell forces %.2f s, contact %.2f s; at the benchmarks' throughput per thread)\n",
+      est.seconds_per_frame(), est.threads, est.bulk_seconds, est.shell_seconds,
+      est.contact_seconds);
   // A step below dt_min stops the run; say so now, with the cause (a warning: exit 0).
   if (dt < s.dt_min)
     std::printf(
@@ -146,6 +120,42 @@ int check_command(const CommonArgs& a) {
         "will stop %s; %s\n",
         dt, s.dt_min, limits.front().upcoming ? "once the sources emit" : "at t = 0",
         describe_step_limits(limits, s.dt_min).c_str());
+}
+
+}  // namespace
+
+int check_command(const CommonArgs& a) {
+  LoadedScene ls = load_scene_for_cli(a, "", "");
+  const Scene& scene = ls.scene;
+  ThreadLimit limit(scene.shot.threads);
+  const ShotSettings& s = scene.shot;
+  std::printf("scene %s: valid\n", scene.path.c_str());
+  std::printf("frames %d-%d at %g fps, dx %g m, domain [%g %g %g]..[%g %g %g]\n", s.frame_start,
+              s.frame_end, s.fps, s.dx, s.domain_min.x(), s.domain_min.y(), s.domain_min.z(),
+              s.domain_max.x(), s.domain_max.y(), s.domain_max.z());
+  const RunMemory mem = estimate_memory(ls);
+  const AvailableMemory avail = available_memory();
+  print_estimate(mem, avail);
+  const double need = mem.peak - mem.baseline;
+  if (mem.peak > kCheckBuildLimit || (avail.known && need > 0.5 * avail.bytes)) {
+    std::printf(
+        "note: check does not build a shot this large (over %s, or over half the "
+        "available memory): its stages and time step are not estimated; `shellmpm "
+        "run` reports them\n",
+        format_bytes(kCheckBuildLimit).c_str());
+    return kExitOk;
+  }
+
+  Solver solver(scene);
+  std::string stages;
+  for (const std::string& n : solver.stage_names()) stages += (stages.empty() ? "" : ", ") + n;
+  std::printf("stages: %s\n", stages.empty() ? "(none: nothing to simulate)" : stages.c_str());
+  if (ShellGuardStage::needed(scene))
+    std::printf("shell guard: gap %g m (%s)\n", ShellGuardStage::gap(scene),
+                scene.shot.shell_guard_gap > 0 ? "shot.shell_guard_gap"
+                                               : "0.05 dx or the thickest contact shell");
+  print_shells(solver);
+  print_time(solver, mem);
   return kExitOk;
 }
 

@@ -19,9 +19,11 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
       ->allow_extra_args(false);
   cmd->add_option("--threads", a.threads, "worker threads (0 = all cores; default: scene)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_flag_callback("--quiet,-q", [&a] { a.verbosity = Verbosity::Quiet; }, "errors only");
-  cmd->add_flag_callback("--verbose,-v", [&a] { a.verbosity = Verbosity::Verbose; },
-                         "per-frame stage timings and energies");
+  cmd->add_flag_callback(
+      "--quiet,-q", [&a] { a.verbosity = Verbosity::Quiet; }, "errors only");
+  cmd->add_flag_callback(
+      "--verbose,-v", [&a] { a.verbosity = Verbosity::Verbose; },
+      "per-frame stage timings and energies");
 }
 
 }  // namespace
@@ -36,7 +38,8 @@ int main(int argc, char** argv) {
   add_common(run_cmd, run);
   run_cmd->add_option("--frames", run.frames, "frame range A-B (or one frame A)");
   run_cmd->add_option("--output,-o", run.output, "output directory (replaces output.directory)");
-  run_cmd->add_flag("--resume", run.resume, "continue from the newest checkpoint in the output directory");
+  run_cmd->add_flag("--resume", run.resume,
+                    "continue from the newest checkpoint in the output directory");
   run_cmd->add_flag("--force", run.force,
                     "run even when the memory estimate exceeds the available memory");
   run_cmd->add_flag("--preview", run.preview,
@@ -44,28 +47,35 @@ int main(int argc, char** argv) {
 
   CommonArgs check;
   CLI::App* check_cmd = app.add_subcommand(
-      "check", "validate a scene; print its stages, particle and grid counts, memory and time estimates");
+      "check",
+      "validate a scene; print its stages, particle and grid counts, memory and time estimates");
   add_common(check_cmd, check);
 
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand(
       "render", "render a run's caches to preview.####.png, a contact sheet and an MP4");
-  render_cmd->add_option("OUTDIR", render.outdir, "output directory of a `shellmpm run`")->required();
-  render_cmd->add_option("--frames", render.frames, "frame range A-B (or one frame A); default: the run's");
+  render_cmd->add_option("OUTDIR", render.outdir, "output directory of a `shellmpm run`")
+      ->required();
+  render_cmd->add_option("--frames", render.frames,
+                         "frame range A-B (or one frame A); default: the run's");
   render_cmd->add_option("--camera", render.camera, "camera name from render.cameras, or auto");
   render_cmd->add_option("--size", render.size, "image size WxH (e.g. 1280x720)");
-  render_cmd->add_option("--renderer", render.renderer, "raster (OpenGL, OSMesa) or raytrace (Embree)")
+  render_cmd
+      ->add_option("--renderer", render.renderer, "raster (OpenGL, OSMesa) or raytrace (Embree)")
       ->check(CLI::IsMember({"raster", "raytrace"}));
-  render_cmd->add_option("--threads", render.threads, "threads for TBB, Embree and llvmpipe (0 = all cores)")
+  render_cmd
+      ->add_option("--threads", render.threads,
+                   "threads for TBB, Embree and llvmpipe (0 = all cores)")
       ->check(CLI::NonNegativeNumber);
   render_cmd->add_option("--scene", render.scene, "scene file to use instead of OUTDIR/run.json");
-  render_cmd->add_option("--set", render.overrides, "override a scene key: key.path=value (repeatable)")
+  render_cmd
+      ->add_option("--set", render.overrides, "override a scene key: key.path=value (repeatable)")
       ->take_all()
       ->allow_extra_args(false);
-  render_cmd->add_flag_callback("--quiet,-q", [&render] { render.verbosity = Verbosity::Quiet; },
-                                "errors only");
-  render_cmd->add_flag_callback("--verbose,-v", [&render] { render.verbosity = Verbosity::Verbose; },
-                                "per-frame timings");
+  render_cmd->add_flag_callback(
+      "--quiet,-q", [&render] { render.verbosity = Verbosity::Quiet; }, "errors only");
+  render_cmd->add_flag_callback(
+      "--verbose,-v", [&render] { render.verbosity = Verbosity::Verbose; }, "per-frame timings");
 
   try {
     app.parse(argc, argv);

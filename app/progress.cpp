@@ -19,7 +19,8 @@ Progress::Progress(Verbosity v, int first_frame, int last_frame)
 }
 
 std::string Progress::eta(int frame) const {
-  const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const double el =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   const int done = frame - first_;
   if (done <= 0) return "--:--:--";
   return format_seconds(el / done * (last_ - frame + 1));
@@ -31,7 +32,8 @@ void Progress::substep(int frame, int sub, double dt, double, std::size_t partic
   if (now - last_draw_ < std::chrono::milliseconds(200)) return;
   last_draw_ = now;
   const double el = std::chrono::duration<double>(now - start_).count();
-  std::fprintf(stderr, "\r\033[Kframe %d/%d  substep %d  dt %.3g s  particles %zu  elapsed %s  ETA %s",
+  std::fprintf(stderr,
+               "\r\033[Kframe %d/%d  substep %d  dt %.3g s  particles %zu  elapsed %s  ETA %s",
                frame, last_, sub, dt, particles, format_seconds(el).c_str(), eta(frame).c_str());
   std::fflush(stderr);
   line_open_ = true;
@@ -41,10 +43,13 @@ void Progress::frame_done(const FrameStats& s) {
   if (verbosity_ == Verbosity::Quiet) return;
   if (line_open_) std::fputs("\r\033[K", stderr);
   line_open_ = false;
-  const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  std::fprintf(stderr, "frame %d/%d  substeps %d  dt %.3g..%.3g s  particles %zu  %.2f s  elapsed %s  ETA %s\n",
-               s.frame, last_, s.substeps, s.dt_min, s.dt_max, s.particles, s.wall_seconds,
-               format_seconds(el).c_str(), eta(s.frame + 1).c_str());
+  const double el =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::fprintf(
+      stderr,
+      "frame %d/%d  substeps %d  dt %.3g..%.3g s  particles %zu  %.2f s  elapsed %s  ETA %s\n",
+      s.frame, last_, s.substeps, s.dt_min, s.dt_max, s.particles, s.wall_seconds,
+      format_seconds(el).c_str(), eta(s.frame + 1).c_str());
   if (verbosity_ == Verbosity::Verbose) {
     std::string line = "  stages:";
     for (const auto& [name, sec] : s.stage_seconds) {

@@ -11,6 +11,7 @@
 #include "render/preview_job.h"
 #include "render/run_manifest.h"
 #include "sim/core/parallel.h"
+#include "sim/scene/scene_words.h"
 
 namespace shellmpm {
 
@@ -50,7 +51,8 @@ int render_command(const RenderArgs& a) {
   if (!a.frames.empty()) parse_frames(a.frames, first, last);
   RenderSettings& rs = scene.render;
   if (!a.size.empty()) parse_size(a.size, rs.width, rs.height);
-  if (!a.renderer.empty()) rs.renderer = a.renderer;
+  if (!a.renderer.empty())
+    rs.renderer = *enum_of_word<RendererKind>(a.renderer);  // CLI checked the word
   if (!a.camera.empty()) {
     std::string names = "auto";
     bool known = a.camera == "auto";
@@ -78,8 +80,8 @@ int render_command(const RenderArgs& a) {
   po.log = say;
   PreviewJob job(scene, po);
   if (a.verbosity == Verbosity::Verbose)
-    say("renderer " + rs.renderer + ", " + std::to_string(rs.width) + "x" + std::to_string(rs.height) +
-        ", threads " + std::to_string(ThreadLimit::active()));
+    say("renderer " + word_of(rs.renderer) + ", " + std::to_string(rs.width) + "x" +
+        std::to_string(rs.height) + ", threads " + std::to_string(ThreadLimit::active()));
   for (int f = first; f <= last; ++f) {
     const auto t0 = std::chrono::steady_clock::now();
     if (job.render_frame(f)) {
@@ -93,7 +95,8 @@ int render_command(const RenderArgs& a) {
   }
   const int failed = job.finish();
   if (failed > 0) {
-    std::fprintf(stderr, "error: %d of %d frames could not be rendered:\n", failed, last - first + 1);
+    std::fprintf(stderr, "error: %d of %d frames could not be rendered:\n", failed,
+                 last - first + 1);
     for (const std::string& e : job.errors()) std::fprintf(stderr, "  %s\n", e.c_str());
     return kExitSimulation;
   }

@@ -15,6 +15,39 @@
 
 namespace shellmpm {
 
+namespace {
+
+/// run.json, which lets `shellmpm render OUTDIR` find the scene later (when the output
+/// folder cannot be made, run_shot reports it).
+void write_manifest(const RunArgs& a, const Scene& scene) {
+  std::error_code ec;
+  std::filesystem::create_directories(scene.output.directory, ec);
+  if (!std::filesystem::is_directory(scene.output.directory, ec)) return;
+  RunManifest m;
+  m.scene_path = std::filesystem::absolute(a.scene).lexically_normal().string();
+  std::ifstream in(a.scene, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  m.scene_text = text.str();
+  m.overrides = a.overrides;
+  m.frame_start = scene.shot.frame_start;
+  m.frame_end = scene.shot.frame_end;
+  write_run_manifest(scene.output.directory, m);
+}
+
+/// The preview renderer of `run --preview` (render.preview), drawing each frame once written.
+std::unique_ptr<PreviewJob> make_preview(const Scene& scene, Progress& progress) {
+  PreviewJobOptions po;
+  po.outdir = scene.output.directory;
+  po.first_frame = po.framing_frame = scene.shot.frame_start;
+  po.last_frame = scene.shot.frame_end;
+  po.threads = scene.shot.threads;
+  po.log = [&progress](const std::string& m) { progress.message(m); };
+  return std::make_unique<PreviewJob>(scene, po);
+}
+
+}  // namespace
+
 int run_command(const RunArgs& a) {
   if (!a.frames.empty()) parse_frames_flag(a.frames);  // before the scene: numbers of any length
   LoadedScene ls = load_scene_for_cli(a, a.frames, a.output);
@@ -24,33 +57,9 @@ int run_command(const RunArgs& a) {
   Progress progress(a.verbosity, scene.shot.frame_start, scene.shot.frame_end);
   if (a.verbosity == Verbosity::Verbose)
     progress.message("threads: " + std::to_string(ThreadLimit::active()));
-  // run.json lets `shellmpm render OUTDIR` find the scene later.
-  {
-    std::error_code ec;
-    std::filesystem::create_directories(scene.output.directory, ec);
-    if (std::filesystem::is_directory(scene.output.directory, ec)) {
-      RunManifest m;
-      m.scene_path = std::filesystem::absolute(a.scene).lexically_normal().string();
-      std::ifstream in(a.scene, std::ios::binary);
-      std::stringstream text;
-      text << in.rdbuf();
-      m.scene_text = text.str();
-      m.overrides = a.overrides;
-      m.frame_start = scene.shot.frame_start;
-      m.frame_end = scene.shot.frame_end;
-      write_run_manifest(scene.output.directory, m);
-    }  // else run_shot reports the directory
-  }
+  write_manifest(a, scene);
   std::unique_ptr<PreviewJob> preview;
-  if (a.preview || scene.render.preview) {
-    PreviewJobOptions po;
-    po.outdir = scene.output.directory;
-    po.first_frame = po.framing_frame = scene.shot.frame_start;
-    po.last_frame = scene.shot.frame_end;
-    po.threads = scene.shot.threads;
-    po.log = [&](const std::string& m) { progress.message(m); };
-    preview = std::make_unique<PreviewJob>(scene, po);
-  }
+  if (a.preview || scene.render.preview) preview = make_preview(scene, progress);
   StopSignals signals;
   bool stop_noted = false;
   auto note_stop = [&](int frame) {
@@ -71,7 +80,8 @@ int run_command(const RunArgs& a) {
   ro.on_frame = [&](const FrameStats& s) {
     if (s.frame < scene.shot.frame_start) return;
     progress.frame_done(s);
-    if (preview && !preview->render_frame(s.frame)) progress.message("error: " + preview->errors().back());
+    if (preview && !preview->render_frame(s.frame))
+      progress.message("error: " + preview->errors().back());
   };
   ro.log = [&](const std::string& m) { progress.message(m); };
   ro.warn = [&](const std::string& m) { progress.warning(m); };

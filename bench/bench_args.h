@@ -28,9 +28,12 @@ struct SheetArgs {
 inline bool parse_sheet_args(int argc, char** argv, SheetArgs& a) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i];
-    if (k == "--vertices") a.vertices = std::atof(argv[i + 1]);
-    else if (k == "--steps") a.steps = std::atoi(argv[i + 1]);
-    else if (k == "--threads") a.threads = parse_int_list(argv[i + 1]);
+    if (k == "--vertices")
+      a.vertices = std::atof(argv[i + 1]);
+    else if (k == "--steps")
+      a.steps = std::atoi(argv[i + 1]);
+    else if (k == "--threads")
+      a.threads = parse_int_list(argv[i + 1]);
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return false;

@@ -56,9 +56,10 @@ int main(int argc, char** argv) {
   ball.shape.radius = 0.35;
   ball.friction = 0.5;
   s.colliders.push_back(ball);
-  std::printf("contact_throughput: cloth %dx%d quads (%d control points, %d contact particles), "
-              "dx = %.4g m, %s\n",
-              n, n, (n + 1) * (n + 1), 2 * n * n, h, sizeof(Real) == 4 ? "float" : "double");
+  std::printf(
+      "contact_throughput: cloth %dx%d quads (%d control points, %d contact particles), "
+      "dx = %.4g m, %s\n",
+      n, n, (n + 1) * (n + 1), 2 * n * n, h, sizeof(Real) == 4 ? "float" : "double");
   double base = 0;
   for (int t : threads) {
     ThreadLimit limit(t);
@@ -73,11 +74,12 @@ int main(int argc, char** argv) {
     const double per_step = sec / fs.substeps;
     const double steps_per_frame = std::ceil(1.0 / (s.shot.fps * dt));
     if (base == 0) base = per_step;
-    std::printf("threads %d: %.1f ms per step, %.0f steps per frame -> %.1f s per frame "
-                "(%.0f ms); speed-up %.2fx; in contact %zu, sliding %zu\n",
-                t, 1e3 * per_step, steps_per_frame, per_step * steps_per_frame,
-                1e3 * per_step * steps_per_frame, base / per_step, fs.contact_compressed,
-                fs.contact_sliding);
+    std::printf(
+        "threads %d: %.1f ms per step, %.0f steps per frame -> %.1f s per frame "
+        "(%.0f ms); speed-up %.2fx; in contact %zu, sliding %zu\n",
+        t, 1e3 * per_step, steps_per_frame, per_step * steps_per_frame,
+        1e3 * per_step * steps_per_frame, base / per_step, fs.contact_compressed,
+        fs.contact_sliding);
     std::map<std::string, double> groups;
     for (const auto& [name, v] : fs.stage_seconds) {
       std::string g = name;

@@ -28,7 +28,7 @@ Scene cube_scene(double cells_per_side, double dx, const std::string& transfer) 
   s.shot.domain_max = Vec3d(1, 1, 1);
   s.shot.cfl = 0.9;
   s.shot.dt_max = 1e-4;  // fixed step: the cube is soft enough that CFL never binds
-  s.shot.transfer = transfer;
+  s.shot.transfer = transfer == "mls" ? Transfer::Mls : Transfer::Apic;
   MaterialDesc m;
   m.name = "jelly";
   m.youngs_modulus = 1e4;
@@ -83,11 +83,16 @@ int main(int argc, char** argv) {
   double dx = 1.0 / 128;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i];
-    if (k == "--particles") target = std::atof(argv[i + 1]);
-    else if (k == "--steps") steps = std::atoi(argv[i + 1]);
-    else if (k == "--transfer") transfer = argv[i + 1];
-    else if (k == "--dx") dx = std::atof(argv[i + 1]);
-    else if (k == "--threads") threads = shellmpm_bench::parse_int_list(argv[i + 1]);
+    if (k == "--particles")
+      target = std::atof(argv[i + 1]);
+    else if (k == "--steps")
+      steps = std::atoi(argv[i + 1]);
+    else if (k == "--transfer")
+      transfer = argv[i + 1];
+    else if (k == "--dx")
+      dx = std::atof(argv[i + 1]);
+    else if (k == "--threads")
+      threads = shellmpm_bench::parse_int_list(argv[i + 1]);
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return 2;
@@ -95,14 +100,17 @@ int main(int argc, char** argv) {
   }
   const double cells = std::round(std::cbrt(target / 8.0));
   const Scene scene = cube_scene(cells, dx, transfer);
-  std::printf("mpm_throughput: elastic cube %gx%gx%g cells, 8 particles/cell, dx %g, %s, %s, %d steps\n",
-              cells, cells, cells, dx, transfer.c_str(), sizeof(Real) == 4 ? "float" : "double", steps);
+  std::printf(
+      "mpm_throughput: elastic cube %gx%gx%g cells, 8 particles/cell, dx %g, %s, %s, %d steps\n",
+      cells, cells, cells, dx, transfer.c_str(), sizeof(Real) == 4 ? "float" : "double", steps);
   double base = 0;
   for (int t : threads) {
     const Result r = run(scene, t, steps);
     if (base == 0) base = r.pss;
-    std::printf("threads %d: %zu particles, %.3f s, %.2f M particle-steps/s (%.2f M per thread), speed-up %.2fx\n",
-                t, r.particles, r.total, r.pss / 1e6, r.pss / 1e6 / t, r.pss / base);
+    std::printf(
+        "threads %d: %zu particles, %.3f s, %.2f M particle-steps/s (%.2f M per thread), speed-up "
+        "%.2fx\n",
+        t, r.particles, r.total, r.pss / 1e6, r.pss / 1e6 / t, r.pss / base);
     std::printf("  stages:");
     for (const auto& [n, s] : r.stage) std::printf(" %s %.1f%%", n.c_str(), 100.0 * s / r.total);
     std::printf("\n  bytes per particle: %.1f in particle arrays, %.1f in the grid and bins\n",

@@ -78,7 +78,8 @@ PreviewScene bench_scene(const Args& a, int frame) {
     state = state * 1664525u + 1013904223u;
     return (state >> 8) * (1.0f / 16777216.0f);
   };
-  for (double y = 0.5 * h; y < 0.45 && static_cast<long>(s.particles.positions.size()) < a.particles; y += h) {
+  for (double y = 0.5 * h;
+       y < 0.45 && static_cast<long>(s.particles.positions.size()) < a.particles; y += h) {
     const double r = 0.6 * (1.0 - y / 0.45);
     for (double x = -r; x <= r; x += h)
       for (double z = -r; z <= r; z += h)
@@ -114,7 +115,8 @@ int child(const Args& a) {
   cam.height = a.height;
   using clock = std::chrono::steady_clock;
   auto t0 = clock::now();
-  std::unique_ptr<Renderer> r = make_renderer(kind, threads);
+  std::unique_ptr<Renderer> r =
+      make_renderer(kind == "raytrace" ? RendererKind::Raytrace : RendererKind::Raster, threads);
   const double setup = std::chrono::duration<double>(clock::now() - t0).count();
   std::vector<double> secs;
   std::size_t tris = 0, pts = 0, drawn = 0;
@@ -132,8 +134,8 @@ int child(const Args& a) {
   for (std::size_t i = 1; i < secs.size(); ++i) steady += secs[i];
   steady = secs.size() > 1 ? steady / static_cast<double>(secs.size() - 1) : secs[0];
   if (!a.cull) drawn = pts;
-  std::printf("| %-8s | %d | %zu | %zu (%zu drawn) | %dx%d | %.2f | %.3f | %.3f |\n", kind.c_str(), threads, tris,
-              pts, drawn, a.width, a.height, setup, secs[0], steady);
+  std::printf("| %-8s | %d | %zu | %zu (%zu drawn) | %dx%d | %.2f | %.3f | %.3f |\n", kind.c_str(),
+              threads, tris, pts, drawn, a.width, a.height, setup, secs[0], steady);
   std::fflush(stdout);
   return 0;
 }
@@ -181,19 +183,26 @@ int main(int argc, char** argv) {
     }
   }
   if (a.child) return child(a);
-  std::printf("render_throughput: 100k-triangle shell + %ld particles + sphere + ground, %d frames "
-              "(ray traced: %d samples/pixel, %d AO rays/sample)\n",
-              a.particles, a.frames, a.samples, a.ao);
-  std::printf("| renderer | threads | triangles | particles | size | setup s | first frame s | s/frame |\n");
+  std::printf(
+      "render_throughput: 100k-triangle shell + %ld particles + sphere + ground, %d frames "
+      "(ray traced: %d samples/pixel, %d AO rays/sample)\n",
+      a.particles, a.frames, a.samples, a.ao);
+  std::printf(
+      "| renderer | threads | triangles | particles | size | setup s | first frame s | s/frame "
+      "|\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   std::fflush(stdout);
   for (const std::string& r : a.renderers)
     for (int t : a.threads) {
-      std::vector<std::string> args = {"/proc/self/exe", "--child", "--renderer", r, "--threads", std::to_string(t),
-                                       "--frames", std::to_string(a.frames), "--size",
-                                       std::to_string(a.width) + "x" + std::to_string(a.height), "--particles",
-                                       std::to_string(a.particles), "--samples", std::to_string(a.samples),
-                                       "--ao", std::to_string(a.ao)};
+      std::vector<std::string> args = {
+          "/proc/self/exe", "--child",
+          "--renderer",     r,
+          "--threads",      std::to_string(t),
+          "--frames",       std::to_string(a.frames),
+          "--size",         std::to_string(a.width) + "x" + std::to_string(a.height),
+          "--particles",    std::to_string(a.particles),
+          "--samples",      std::to_string(a.samples),
+          "--ao",           std::to_string(a.ao)};
       if (!a.cull) args.push_back("--no-cull");
       std::vector<char*> argv2;
       for (std::string& s : args) argv2.push_back(s.data());

@@ -46,14 +46,15 @@ int main(int argc, char** argv) {
   s.shells.push_back(sh);
   const auto t_setup = std::chrono::steady_clock::now();
   Solver probe(s);
-  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
+  const double setup =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_setup).count();
   const auto& kl = probe.shells()[0]->kl();
   const double qp = static_cast<double>(kl.num_quadrature_points());
   const int layers = kl.num_layers();
-  std::printf("shell_throughput: sheet %dx%d quads, %zu control points, %.0f in-plane quadrature "
-              "points x %d layers, %s, setup %.2f s\n",
-              n, n, probe.shells()[0]->size(), qp, layers, sizeof(Real) == 4 ? "float" : "double",
-              setup);
+  std::printf(
+      "shell_throughput: sheet %dx%d quads, %zu control points, %.0f in-plane quadrature "
+      "points x %d layers, %s, setup %.2f s\n",
+      n, n, probe.shells()[0]->size(), qp, layers, sizeof(Real) == 4 ? "float" : "double", setup);
   double base = 0;
   for (int t : threads) {
     ThreadLimit limit(t);
@@ -70,10 +71,11 @@ int main(int argc, char** argv) {
     const double per_step = sec / fs.substeps;
     const double qps = qp * fs.substeps / forces;
     if (base == 0) base = per_step;
-    std::printf("threads %d: %.2f ms per step (forces %.2f ms), %.2f M quadrature points/s "
-                "(%.2f M layer evaluations/s, %.2f M per thread), speed-up %.2fx\n",
-                t, 1e3 * per_step, 1e3 * forces / fs.substeps, qps / 1e6, qps * layers / 1e6,
-                qps * layers / 1e6 / t, base / per_step);
+    std::printf(
+        "threads %d: %.2f ms per step (forces %.2f ms), %.2f M quadrature points/s "
+        "(%.2f M layer evaluations/s, %.2f M per thread), speed-up %.2fx\n",
+        t, 1e3 * per_step, 1e3 * forces / fs.substeps, qps / 1e6, qps * layers / 1e6,
+        qps * layers / 1e6 / t, base / per_step);
   }
   return 0;
 }

@@ -24,7 +24,7 @@ struct Checkpoint {
   int frame = 0;                        ///< last frame completed
   double time = 0;                      ///< simulation time [s]
   ParticleSet particles;
-  std::string stats_json;               ///< statistics of the frames written so far
+  std::string stats_json;  ///< statistics of the frames written so far
   /// Per shell: control point positions, velocities and the denting plastic state.
   struct ShellState {
     std::vector<Vec3> x, v;

@@ -101,6 +101,173 @@ std::uint32_t compression_flags() {
          openvdb::io::COMPRESS_ACTIVE_MASK;
 }
 
+/// (leaf key, particle index) for every particle, sorted: the leaf holding its first stencil
+/// node. Throws for a non-finite position, a negative volume or a position out of range.
+std::vector<std::pair<std::uint64_t, std::size_t>> particles_by_leaf(const DensityInput& in,
+                                                                     double inv_h) {
+  const std::size_t n = in.count;
+  std::vector<std::pair<std::uint64_t, std::size_t>> order(n);
+  std::vector<std::size_t> bad_chunk((n + 4095) / 4096, n);
+  parallel_for(n, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t p = b; p < e; ++p) {
+      const Vec3& x = in.positions[p];
+      std::array<int, 3> leaf{};
+      bool ok = std::isfinite(static_cast<double>(in.volumes[p])) && in.volumes[p] >= 0;
+      for (int a = 0; a < 3 && ok; ++a) {
+        const double g = static_cast<double>(x[a]) * inv_h;
+        ok = std::isfinite(g) && std::abs(g) < kMaxIndex;
+        if (ok) leaf[a] = leaf_of(stencil(g).base);
+      }
+      if (!ok) {
+        bad_chunk[b / 4096] = std::min(bad_chunk[b / 4096], p);
+        leaf = {0, 0, 0};
+      }
+      order[p] = {pack_leaf(leaf), p};
+    }
+  });
+  for (std::size_t c : bad_chunk)
+    if (c < n) {
+      std::ostringstream os;
+      os << "write_density_vdb: particle " << c << " has position " << describe(in.positions[c])
+         << " and volume " << in.volumes[c] << " (non-finite, negative volume, or beyond "
+         << kMaxIndex << " voxels from the origin)";
+      throw std::invalid_argument(os.str());
+    }
+  // (key, index) pairs are unique, so the sorted order does not depend on threads.
+  tbb::parallel_sort(order.begin(), order.end());
+  return order;
+}
+
+/// Runs of particles with the same leaf key, and the output leaves they reach: a bucket's
+/// leaf and its +1 neighbours (a stencil starting in leaf L reaches at most 2 voxels into
+/// L+1).
+struct Buckets {
+  std::vector<std::uint64_t> key;
+  std::vector<std::size_t> begin;  ///< first sorted index of each bucket, plus n at the end
+  std::vector<std::uint64_t> out_keys;
+};
+
+Buckets make_buckets(const std::vector<std::pair<std::uint64_t, std::size_t>>& order) {
+  Buckets bk;
+  const std::size_t n = order.size();
+  for (std::size_t i = 0; i < n; ++i)
+    if (i == 0 || order[i].first != order[i - 1].first) {
+      bk.key.push_back(order[i].first);
+      bk.begin.push_back(i);
+    }
+  bk.begin.push_back(n);
+  bk.out_keys.reserve(bk.key.size() * 8);
+  for (std::uint64_t k : bk.key) {
+    const auto l = unpack_leaf(k);
+    for (int d = 0; d < 8; ++d)
+      bk.out_keys.push_back(pack_leaf({l[0] + (d & 1), l[1] + ((d >> 1) & 1), l[2] + (d >> 2)}));
+  }
+  std::sort(bk.out_keys.begin(), bk.out_keys.end());
+  bk.out_keys.erase(std::unique(bk.out_keys.begin(), bk.out_keys.end()), bk.out_keys.end());
+  return bk;
+}
+
+/// One particle's stencil in the sorted order (contiguous for the gather).
+struct Stencil3 {
+  int base[3];
+  double w[3][3];  // w[0] is premultiplied by the particle volume
+};
+
+/// Sums into one output leaf's dense 8^3 block (acc: density weights; mom: momentum) the
+/// particles of the (up to) 8 buckets that can reach it, always in the same order. Returns
+/// whether any particle touched it.
+bool gather_leaf(std::uint64_t leaf_key, const Buckets& bk, const std::vector<Stencil3>& st,
+                 const std::vector<Vec3d>& vel_sorted, bool want_vel, std::vector<double>& acc,
+                 std::vector<double>& mom) {
+  const auto l = unpack_leaf(leaf_key);
+  const int origin[3] = {l[0] * kLeafDim, l[1] * kLeafDim, l[2] * kLeafDim};
+  std::fill(acc.begin(), acc.end(), 0.0);
+  std::fill(mom.begin(), mom.end(), 0.0);
+  bool any = false;
+  for (int d = 7; d >= 0; --d) {  // source buckets L - {0,1}^3, in a fixed order
+    const std::uint64_t sk = pack_leaf({l[0] - (d & 1), l[1] - ((d >> 1) & 1), l[2] - (d >> 2)});
+    const auto it = std::lower_bound(bk.key.begin(), bk.key.end(), sk);
+    if (it == bk.key.end() || *it != sk) continue;
+    const std::size_t bi = static_cast<std::size_t>(it - bk.key.begin());
+    for (std::size_t s = bk.begin[bi]; s < bk.begin[bi + 1]; ++s) {
+      const Stencil3& ps = st[s];
+      int lo[3], hi[3];
+      bool touches = true;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::max(0, origin[a] - ps.base[a]);
+        hi[a] = std::min(2, origin[a] + kLeafDim - 1 - ps.base[a]);
+        touches = touches && lo[a] <= hi[a];
+      }
+      if (!touches) continue;
+      any = true;
+      const int o0 = ps.base[0] - origin[0], o1 = ps.base[1] - origin[1],
+                o2 = ps.base[2] - origin[2];
+      for (int i = lo[0]; i <= hi[0]; ++i) {
+        const double wi = ps.w[0][i];
+        const int oi = (o0 + i) << (2 * kLeafLog2);
+        for (int j = lo[1]; j <= hi[1]; ++j) {
+          const double wij = wi * ps.w[1][j];
+          const int oij = oi | ((o1 + j) << kLeafLog2);
+          for (int k = lo[2]; k <= hi[2]; ++k) acc[oij | (o2 + k)] += wij * ps.w[2][k];
+          if (!want_vel) continue;
+          const Vec3d& v = vel_sorted[s];
+          for (int k = lo[2]; k <= hi[2]; ++k) {
+            const double w = wij * ps.w[2][k];
+            double* m = &mom[3 * (oij | (o2 + k))];
+            m[0] += w * v[0];
+            m[1] += w * v[1];
+            m[2] += w * v[2];
+          }
+        }
+      }
+    }
+  }
+  return any;
+}
+
+/// The density (and velocity) leaves of one gathered block; null where nothing is active.
+std::pair<std::unique_ptr<FloatLeaf>, std::unique_ptr<VecLeaf>> make_leaves(
+    std::uint64_t leaf_key, const std::vector<double>& acc, const std::vector<double>& mom,
+    bool want_vel, double inv_cell_volume) {
+  const auto l = unpack_leaf(leaf_key);
+  const openvdb::Coord c(l[0] * kLeafDim, l[1] * kLeafDim, l[2] * kLeafDim);
+  auto dl = std::make_unique<FloatLeaf>(c, 0.0f, false);
+  std::unique_ptr<VecLeaf> vl;
+  if (want_vel) vl = std::make_unique<VecLeaf>(c, openvdb::Vec3s(0.0f), false);
+  bool active = false;
+  for (openvdb::Index off = 0; off < FloatLeaf::SIZE; ++off) {
+    if (!(acc[off] > 0.0)) continue;
+    const float value = static_cast<float>(acc[off] * inv_cell_volume);
+    if (value == 0.0f) continue;  // underflow: keep "0 means inactive" exact
+    active = true;
+    dl->setValueOn(off, value);
+    if (want_vel) {
+      const double inv = 1.0 / acc[off];
+      vl->setValueOn(off, openvdb::Vec3s(static_cast<float>(mom[3 * off] * inv),
+                                         static_cast<float>(mom[3 * off + 1] * inv),
+                                         static_cast<float>(mom[3 * off + 2] * inv)));
+    }
+  }
+  if (!active) return {nullptr, nullptr};
+  return {std::move(dl), std::move(vl)};
+}
+
+/// A grid of the leaves, in sorted order, with the file's transform and metadata.
+template <class GridT, class LeafT>
+typename GridT::Ptr make_grid(const char* name, typename GridT::ValueType background,
+                              const openvdb::math::Transform::Ptr& xform, const VdbOptions& o,
+                              std::vector<std::unique_ptr<LeafT>>& leaves) {
+  typename GridT::Ptr g = GridT::create(background);
+  g->setName(name);
+  g->setTransform(xform);
+  g->setSaveFloatAsHalf(o.half_float);
+  g->setCreator("shellmpm");
+  add_metadata(*g, o);
+  for (auto& leaf : leaves)
+    if (leaf) g->tree().addLeaf(leaf.release());
+  return g;
+}
+
 }  // namespace
 
 void write_density_vdb(const std::string& path, const DensityInput& in, const VdbOptions& o) {
@@ -112,68 +279,12 @@ void write_density_vdb(const std::string& path, const DensityInput& in, const Vd
   if (o.velocity && in.count > 0 && !in.velocities)
     throw std::invalid_argument("write_density_vdb: velocity grid asked for without velocities");
   openvdb::initialize();
-
   const std::size_t n = in.count;
   const double inv_h = 1.0 / h;
-
-  // 1. Each particle's leaf key (the leaf holding its first stencil node); validate.
-  std::vector<std::pair<std::uint64_t, std::size_t>> order(n);
-  {
-    std::vector<std::size_t> bad_chunk((n + 4095) / 4096, n);
-    parallel_for(n, 4096, [&](std::size_t b, std::size_t e) {
-      for (std::size_t p = b; p < e; ++p) {
-        const Vec3& x = in.positions[p];
-        std::array<int, 3> leaf{};
-        bool ok = std::isfinite(static_cast<double>(in.volumes[p])) && in.volumes[p] >= 0;
-        for (int a = 0; a < 3 && ok; ++a) {
-          const double g = static_cast<double>(x[a]) * inv_h;
-          ok = std::isfinite(g) && std::abs(g) < kMaxIndex;
-          if (ok) leaf[a] = leaf_of(stencil(g).base);
-        }
-        if (!ok) {
-          bad_chunk[b / 4096] = std::min(bad_chunk[b / 4096], p);
-          leaf = {0, 0, 0};
-        }
-        order[p] = {pack_leaf(leaf), p};
-      }
-    });
-    for (std::size_t c : bad_chunk)
-      if (c < n) {
-        std::ostringstream os;
-        os << "write_density_vdb: particle " << c << " has position " << describe(in.positions[c])
-           << " and volume " << in.volumes[c] << " (non-finite, negative volume, or beyond "
-           << kMaxIndex << " voxels from the origin)";
-        throw std::invalid_argument(os.str());
-      }
-  }
-  // (key, index) pairs are unique, so the sorted order does not depend on threads.
-  tbb::parallel_sort(order.begin(), order.end());
-
-  // 2. Buckets: runs of equal key. Output leaves: a bucket's leaf and its +1 neighbours
-  //    (a stencil starting in leaf L reaches at most 2 voxels into L+1).
-  std::vector<std::uint64_t> bucket_key;
-  std::vector<std::size_t> bucket_begin;
-  for (std::size_t i = 0; i < n; ++i)
-    if (i == 0 || order[i].first != order[i - 1].first) {
-      bucket_key.push_back(order[i].first);
-      bucket_begin.push_back(i);
-    }
-  bucket_begin.push_back(n);
-  std::vector<std::uint64_t> out_keys;
-  out_keys.reserve(bucket_key.size() * 8);
-  for (std::uint64_t k : bucket_key) {
-    const auto l = unpack_leaf(k);
-    for (int d = 0; d < 8; ++d)
-      out_keys.push_back(pack_leaf({l[0] + (d & 1), l[1] + ((d >> 1) & 1), l[2] + (d >> 2)}));
-  }
-  std::sort(out_keys.begin(), out_keys.end());
-  out_keys.erase(std::unique(out_keys.begin(), out_keys.end()), out_keys.end());
-
-  // 3. Each particle's stencil, once, in sorted order (contiguous for the gather).
-  struct Stencil3 {
-    int base[3];
-    double w[3][3];  // w[0] is premultiplied by the particle volume
-  };
+  // 1. Each particle's leaf key, sorted; 2. the buckets and the leaves they reach.
+  const std::vector<std::pair<std::uint64_t, std::size_t>> order = particles_by_leaf(in, inv_h);
+  const Buckets bk = make_buckets(order);
+  // 3. Each particle's stencil, once, in sorted order.
   std::vector<Stencil3> st(n);
   const bool want_vel = o.velocity;
   std::vector<Vec3d> vel_sorted(want_vel ? n : 0);
@@ -189,111 +300,32 @@ void write_density_vdb(const std::string& path, const DensityInput& in, const Vd
       if (want_vel) vel_sorted[s] = in.velocities[p].template cast<double>();
     }
   });
-
-  // 4. Gather: each output leaf sums the particles of the (up to) 8 buckets that can
-  //    reach it, always in the same order, into a dense 8^3 block. No atomics, and the
-  //    result of a leaf does not depend on which thread computes it.
-  std::vector<std::unique_ptr<FloatLeaf>> dens_leaves(out_keys.size());
-  std::vector<std::unique_ptr<VecLeaf>> vel_leaves(want_vel ? out_keys.size() : 0);
+  // 4. Gather per output leaf: no atomics, and a leaf's result does not depend on which
+  //    thread computes it.
+  std::vector<std::unique_ptr<FloatLeaf>> dens_leaves(bk.out_keys.size());
+  std::vector<std::unique_ptr<VecLeaf>> vel_leaves(want_vel ? bk.out_keys.size() : 0);
   const double inv_cell_volume = inv_h * inv_h * inv_h;
-  parallel_for(out_keys.size(), 4, [&](std::size_t lb, std::size_t le) {
+  parallel_for(bk.out_keys.size(), 4, [&](std::size_t lb, std::size_t le) {
     std::vector<double> acc(FloatLeaf::SIZE), mom(want_vel ? 3 * FloatLeaf::SIZE : 0);
     for (std::size_t li = lb; li < le; ++li) {
-      const auto l = unpack_leaf(out_keys[li]);
-      const int origin[3] = {l[0] * kLeafDim, l[1] * kLeafDim, l[2] * kLeafDim};
-      std::fill(acc.begin(), acc.end(), 0.0);
-      std::fill(mom.begin(), mom.end(), 0.0);
-      bool any = false;
-      for (int d = 7; d >= 0; --d) {  // source buckets L - {0,1}^3, in a fixed order
-        const std::uint64_t sk =
-            pack_leaf({l[0] - (d & 1), l[1] - ((d >> 1) & 1), l[2] - (d >> 2)});
-        const auto it = std::lower_bound(bucket_key.begin(), bucket_key.end(), sk);
-        if (it == bucket_key.end() || *it != sk) continue;
-        const std::size_t bi = static_cast<std::size_t>(it - bucket_key.begin());
-        for (std::size_t s = bucket_begin[bi]; s < bucket_begin[bi + 1]; ++s) {
-          const Stencil3& ps = st[s];
-          int lo[3], hi[3];
-          bool touches = true;
-          for (int a = 0; a < 3; ++a) {
-            lo[a] = std::max(0, origin[a] - ps.base[a]);
-            hi[a] = std::min(2, origin[a] + kLeafDim - 1 - ps.base[a]);
-            touches = touches && lo[a] <= hi[a];
-          }
-          if (!touches) continue;
-          any = true;
-          const int o0 = ps.base[0] - origin[0], o1 = ps.base[1] - origin[1],
-                    o2 = ps.base[2] - origin[2];
-          for (int i = lo[0]; i <= hi[0]; ++i) {
-            const double wi = ps.w[0][i];
-            const int oi = (o0 + i) << (2 * kLeafLog2);
-            for (int j = lo[1]; j <= hi[1]; ++j) {
-              const double wij = wi * ps.w[1][j];
-              const int oij = oi | ((o1 + j) << kLeafLog2);
-              for (int k = lo[2]; k <= hi[2]; ++k) acc[oij | (o2 + k)] += wij * ps.w[2][k];
-              if (!want_vel) continue;
-              const Vec3d& v = vel_sorted[s];
-              for (int k = lo[2]; k <= hi[2]; ++k) {
-                const double w = wij * ps.w[2][k];
-                double* m = &mom[3 * (oij | (o2 + k))];
-                m[0] += w * v[0];
-                m[1] += w * v[1];
-                m[2] += w * v[2];
-              }
-            }
-          }
-        }
-      }
-      if (!any) continue;
-      const openvdb::Coord c(origin[0], origin[1], origin[2]);
-      auto dl = std::make_unique<FloatLeaf>(c, 0.0f, false);
-      std::unique_ptr<VecLeaf> vl;
-      if (want_vel) vl = std::make_unique<VecLeaf>(c, openvdb::Vec3s(0.0f), false);
-      bool active = false;
-      for (openvdb::Index off = 0; off < FloatLeaf::SIZE; ++off) {
-        if (!(acc[off] > 0.0)) continue;
-        const float value = static_cast<float>(acc[off] * inv_cell_volume);
-        if (value == 0.0f) continue;  // underflow: keep "0 means inactive" exact
-        active = true;
-        dl->setValueOn(off, value);
-        if (want_vel) {
-          const double inv = 1.0 / acc[off];
-          vl->setValueOn(off, openvdb::Vec3s(static_cast<float>(mom[3 * off] * inv),
-                                             static_cast<float>(mom[3 * off + 1] * inv),
-                                             static_cast<float>(mom[3 * off + 2] * inv)));
-        }
-      }
-      if (!active) continue;
-      dens_leaves[li] = std::move(dl);
-      if (want_vel) vel_leaves[li] = std::move(vl);
+      if (!gather_leaf(bk.out_keys[li], bk, st, vel_sorted, want_vel, acc, mom)) continue;
+      auto leaves = make_leaves(bk.out_keys[li], acc, mom, want_vel, inv_cell_volume);
+      dens_leaves[li] = std::move(leaves.first);
+      if (want_vel) vel_leaves[li] = std::move(leaves.second);
     }
   });
-
   // 5. Trees from the leaves, in sorted order.
   auto xform = openvdb::math::Transform::createLinearTransform(h);
-  openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.0f);
-  density->setName("density");
+  openvdb::FloatGrid::Ptr density =
+      make_grid<openvdb::FloatGrid>("density", 0.0f, xform, o, dens_leaves);
   density->setGridClass(openvdb::GRID_FOG_VOLUME);
-  density->setTransform(xform);
-  density->setSaveFloatAsHalf(o.half_float);
-  density->setCreator("shellmpm");
-  add_metadata(*density, o);
-  for (auto& leaf : dens_leaves)
-    if (leaf) density->tree().addLeaf(leaf.release());
-
   openvdb::GridPtrVec grids{density};
   if (want_vel) {
-    openvdb::Vec3SGrid::Ptr vel = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-    vel->setName("vel");
+    openvdb::Vec3SGrid::Ptr vel =
+        make_grid<openvdb::Vec3SGrid>("vel", openvdb::Vec3s(0.0f), xform->copy(), o, vel_leaves);
     vel->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
-    vel->setTransform(xform->copy());
-    vel->setSaveFloatAsHalf(o.half_float);
-    vel->setCreator("shellmpm");
-    add_metadata(*vel, o);
-    for (auto& leaf : vel_leaves)
-      if (leaf) vel->tree().addLeaf(leaf.release());
     grids.push_back(vel);
   }
-
   openvdb::MetaMap file_meta;
   add_metadata(file_meta, o);
   VdbFileWriter archive;

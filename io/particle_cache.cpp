@@ -11,7 +11,8 @@ void write_particle_ply(const std::string& path, const ParticleSet& p) {
   const std::size_t n = p.size();
   std::string header = "ply\nformat binary_little_endian 1.0\ncomment shellmpm particle cache\n";
   header += "element vertex " + std::to_string(n) + "\n";
-  for (const char* a : {"x", "y", "z", "vx", "vy", "vz"}) header += std::string("property float ") + a + "\n";
+  for (const char* a : {"x", "y", "z", "vx", "vy", "vz"})
+    header += std::string("property float ") + a + "\n";
   header += "property uint id\nend_header\n";
   constexpr std::size_t kRecord = 6 * 4 + 4;
   std::vector<char> body(n * kRecord);

@@ -52,7 +52,7 @@ RunMemory estimate_run_memory(const Scene& scene, double baseline) {
   {
     // Shell meshes: limit positions and normals, then the encoded file in memory (OBJ is
     // text, about 80 bytes a vertex and 40 a triangle; PLY and GLB are binary).
-    const bool text = o.shell_format == "obj";
+    const bool text = o.shell_format == MeshFormat::Obj;
     // With output.velocity, PLY and GLB also carry a velocity (a Vec3 and 12 bytes a vertex).
     const bool vel = o.velocity && !text;
     const double per_vertex = (vel ? 3 : 2) * kVec3 + (text ? 80 : 32) + (vel ? 12 : 0);

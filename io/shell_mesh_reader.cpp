@@ -48,7 +48,6 @@ struct Collector {
     if (detail::append_triangles(am, m, mesh.vertices, mesh.uvs, mesh.triangles, all_have_uvs))
       name_range(am->mName, first);
   }
-
 };
 
 struct PositionKey {

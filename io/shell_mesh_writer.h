@@ -30,10 +30,9 @@
 #include <string>
 
 #include "sim/core/types.h"
+#include "sim/scene/scene.h"
 
 namespace shellmpm {
-
-enum class MeshFormat { Ply, Obj, Glb };
 
 /// "ply" | "obj" | "glb" (lower case). Throws std::invalid_argument otherwise.
 MeshFormat parse_mesh_format(const std::string& name);

@@ -13,6 +13,7 @@
 #include "io/shell_mesh_writer.h"
 #include "io/stats_file.h"
 #include "io/user_error.h"
+#include "sim/scene/scene_words.h"
 #include "sim/solver/solver.h"
 
 namespace shellmpm {
@@ -34,7 +35,7 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
   }
   if (o.particles && !scene.sources.empty())
     write_particle_ply(frame_path(o.directory, o.particles_pattern, frame), p);
-  const MeshFormat format = parse_mesh_format(o.shell_format);
+  const MeshFormat format = o.shell_format;
   std::vector<Vec3> pos, nrm, vel;
   for (const auto& sh : solver.shells()) {
     if (!sh->desc().write_mesh) continue;
@@ -65,7 +66,8 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
 /// name below it (a shell pattern "meshes/{name}.####.ply").
 std::vector<std::string> output_folders(const Scene& scene) {
   const OutputSettings& o = scene.output;
-  std::vector<std::string> patterns = {o.density_pattern, o.particles_pattern, scene.render.pattern};
+  std::vector<std::string> patterns = {o.density_pattern, o.particles_pattern,
+                                       scene.render.pattern};
   for (const ShellDesc& sh : scene.shells) {
     std::string pattern = o.shell_pattern;
     const auto at = pattern.find("{name}");
@@ -146,6 +148,73 @@ Checkpoint capture(const Solver& solver, const StatsFile& stats, int frame, std:
   return c;
 }
 
+/// Where a run starts: frame 1, or after the checkpoint `--resume` found.
+struct ResumePoint {
+  bool resumed = false;
+  int first_frame = 1;
+  Checkpoint ck;
+  std::string ck_path;
+  nlohmann::json note;  ///< stats.json's "resume" entry
+};
+
+/// With --resume: removes a killed run's temporary files and finds the checkpoint to go on
+/// from (refusing one written for another scene).
+ResumePoint find_resume_point(const Scene& scene, const RunOptions& opt,
+                              const std::function<void(const std::string&)>& log) {
+  ResumePoint rp;
+  if (!opt.resume) return rp;
+  int removed = 0;
+  for (const std::string& d : output_folders(scene)) removed += remove_atomic_temps(d);
+  if (removed > 0)
+    log("removed " + std::to_string(removed) + " temporary file(s) left by a killed run");
+  if (!find_resume_checkpoint(scene, opt, rp.ck, rp.ck_path, rp.note)) {
+    log("no checkpoint in '" + scene.output.directory + "': starting from frame 1");
+    return rp;
+  }
+  if (rp.ck.scene_fingerprint != opt.scene_fingerprint)
+    throw UserError(rp.ck_path, 0, "",
+                    "checkpoint was written for a different scene or --set overrides; "
+                    "delete it or run without --resume");
+  rp.resumed = true;
+  rp.first_frame = rp.ck.frame + 1;
+  log("resuming after frame " + std::to_string(rp.ck.frame) + " from '" + rp.ck_path + "'");
+  return rp;
+}
+
+/// Simulates up to frame `frame` (frame 1: measures the initial state).
+FrameStats simulate_frame(Solver& solver, int frame, const RunOptions& opt) {
+  FrameStats fs;
+  if (frame == 1) {
+    solver.measure(fs);  // frame 1 is the initial state
+    fs.time = solver.time();
+    fs.integrity = solver.integrity_snapshot();
+  } else {
+    fs = solver.advance_to(frame_time(frame, solver.scene().shot.fps),
+                           [&](int sub, double dt, double t) {
+                             if (opt.on_substep)
+                               opt.on_substep(frame, sub, dt, t, solver.particles().size());
+                           });
+  }
+  fs.frame = frame;
+  return fs;
+}
+
+/// Says what the frame's integrity check found; with on_integrity_failure: stop, a failed
+/// frame ends the run (its statistics kept, its caches not written: wrong physics).
+void report_integrity(const Scene& scene, const FrameStats& fs, const RunOptions& opt,
+                      StatsFile& stats) {
+  if (fs.integrity.events.empty()) return;
+  const std::vector<std::string> lines = describe_integrity(fs.integrity, fs.frame, scene.shot.dx);
+  for (const std::string& l : lines)
+    if (opt.warn) opt.warn(l);
+  if (fs.integrity.failed() &&
+      scene.shot.on_integrity_failure == ShotSettings::OnIntegrityFailure::Stop) {
+    stats.add(fs);
+    stats.write();
+    throw SimulationError(lines.front() + " (shot.on_integrity_failure: stop)");
+  }
+}
+
 }  // namespace
 
 RunResult run_shot(const Scene& scene, const RunOptions& opt) {
@@ -160,77 +229,33 @@ RunResult run_shot(const Scene& scene, const RunOptions& opt) {
   if (ec || !std::filesystem::is_directory(out.directory))
     throw UserError(scene.path, 0, "output.directory",
                     "cannot create output directory '" + out.directory + "': " + ec.message());
-
+  ResumePoint rp = find_resume_point(scene, opt, log);
   SolverOptions so;
   so.serial = opt.serial;
-  int first_frame = 1;
-  Checkpoint ck;
-  std::string ck_path;
-  nlohmann::json resume_note;
-  bool resumed = false;
-  if (opt.resume) {
-    int removed = 0;
-    for (const std::string& d : output_folders(scene)) removed += remove_atomic_temps(d);
-    if (removed > 0)
-      log("removed " + std::to_string(removed) + " temporary file(s) left by a killed run");
-    if (!find_resume_checkpoint(scene, opt, ck, ck_path, resume_note)) {
-      log("no checkpoint in '" + out.directory + "': starting from frame 1");
-    } else {
-      if (ck.scene_fingerprint != opt.scene_fingerprint)
-        throw UserError(ck_path, 0, "",
-                        "checkpoint was written for a different scene or --set overrides; "
-                        "delete it or run without --resume");
-      so.fill_sources = false;
-      resumed = true;
-      first_frame = ck.frame + 1;
-      log("resuming after frame " + std::to_string(ck.frame) + " from '" + ck_path + "'");
-    }
-  }
+  so.fill_sources = !rp.resumed;
   Solver solver(scene, so);
   nlohmann::json header;
   header["scene"] = scene.path;
   header["dx"] = shot.dx;
   header["fps"] = shot.fps;
-  header["transfer"] = shot.transfer;
+  header["transfer"] = word_of(shot.transfer);
   header["stages"] = solver.stage_names();
-  if (resumed) header["resume"] = resume_note;
+  if (rp.resumed) header["resume"] = rp.note;
   StatsFile stats(out.directory + "/" + out.stats_file, header);
-  if (!resumed && scene.preroll.enabled) {
+  if (!rp.resumed && scene.preroll.enabled) {
     const int steps = solver.preroll(scene.preroll);
     log("pre-roll settled the shells in " + std::to_string(steps) + " steps");
   }
-  if (resumed) {
-    stats.set_frames(nlohmann::json::parse(ck.stats_json));
-    restore_checkpoint(solver, std::move(ck), ck_path);
+  if (rp.resumed) {
+    stats.set_frames(nlohmann::json::parse(rp.ck.stats_json));
+    restore_checkpoint(solver, std::move(rp.ck), rp.ck_path);
   }
 
   RunResult result;
-  for (int frame = first_frame; frame <= shot.frame_end; ++frame) {
-    const double t_end = frame_time(frame, shot.fps);
-    FrameStats fs;
-    if (frame == 1) {
-      solver.measure(fs);  // frame 1 is the initial state
-      fs.time = solver.time();
-      fs.integrity = solver.integrity_snapshot();
-    } else {
-      fs = solver.advance_to(t_end, [&](int sub, double dt, double t) {
-        if (opt.on_substep) opt.on_substep(frame, sub, dt, t, solver.particles().size());
-      });
-    }
-    fs.frame = frame;
+  for (int frame = rp.first_frame; frame <= shot.frame_end; ++frame) {
+    const FrameStats fs = simulate_frame(solver, frame, opt);
     result.last_frame = frame;
-    if (!fs.integrity.events.empty()) {
-      const std::vector<std::string> lines = describe_integrity(fs.integrity, frame, shot.dx);
-      for (const std::string& l : lines)
-        if (opt.warn) opt.warn(l);
-      if (fs.integrity.failed() &&
-          shot.on_integrity_failure == ShotSettings::OnIntegrityFailure::Stop) {
-        // The frame's statistics are kept; its caches are not written (wrong physics).
-        stats.add(fs);
-        stats.write();
-        throw SimulationError(lines.front() + " (shot.on_integrity_failure: stop)");
-      }
-    }
+    report_integrity(scene, fs, opt, stats);
     if (frame >= shot.frame_start) {
       write_frame_outputs(scene, solver, frame);
       stats.add(fs);

@@ -12,9 +12,9 @@
 namespace shellmpm {
 
 struct RunOptions {
-  bool resume = false;                 ///< continue from the newest checkpoint in the output dir
-  std::uint64_t scene_fingerprint = 0; ///< identifies the scene text for checkpoints
-  bool serial = false;                 ///< no threads
+  bool resume = false;                  ///< continue from the newest checkpoint in the output dir
+  std::uint64_t scene_fingerprint = 0;  ///< identifies the scene text for checkpoints
+  bool serial = false;                  ///< no threads
   /// After each substep: frame being computed, substep, dt [s], time [s], particle count.
   std::function<void(int, int, double, double, std::size_t)> on_substep;
   /// After each frame is simulated and written.
@@ -43,7 +43,9 @@ struct RunResult {
 constexpr int kMaxFrameNumber = 999999999;
 
 /// Time of a frame's state [s].
-inline double frame_time(int frame, double fps) { return (frame - 1) / fps; }
+inline double frame_time(int frame, double fps) {
+  return (frame - 1) / fps;
+}
 
 /// Simulates scene.shot.frame_start..frame_end (simulating from frame 1, or from the
 /// checkpoint), writing outputs into scene.output.directory.

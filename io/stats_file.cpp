@@ -81,7 +81,9 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
 StatsFile::StatsFile(std::string path, nlohmann::json header)
     : path_(std::move(path)), header_(std::move(header)) {}
 
-void StatsFile::add(const FrameStats& s) { frames_.push_back(frame_stats_json(s)); }
+void StatsFile::add(const FrameStats& s) {
+  frames_.push_back(frame_stats_json(s));
+}
 
 void StatsFile::write() const {
   nlohmann::json j = header_;

@@ -8,10 +8,10 @@ namespace shellmpm {
 namespace {
 
 struct Entry {
-  int col;           ///< column of the key
+  int col;  ///< column of the key
   std::string key;
-  int item = -1;     ///< index of the current list item under this key (-1: none)
-  int item_col = -1; ///< column of that list's "- " markers
+  int item = -1;      ///< index of the current list item under this key (-1: none)
+  int item_col = -1;  ///< column of that list's "- " markers
 };
 
 /// A plain key at the start of s ("name:" followed by a space, end or comment); its length.

@@ -5,7 +5,9 @@
 
 namespace shellmpm {
 
-double Camera::tan_half_fov() const { return std::tan(0.5 * fov_deg * M_PI / 180.0); }
+double Camera::tan_half_fov() const {
+  return std::tan(0.5 * fov_deg * M_PI / 180.0);
+}
 
 Vec3d Camera::ray_direction(double px, double py) const {
   const double t = tan_half_fov();

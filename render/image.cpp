@@ -31,9 +31,10 @@ void png_warning_fn(png_structp, png_const_charp) {}
 
 // libpng reports errors by longjmp: no C++ object with a destructor may be created in
 // these two functions after setjmp; the pixel buffers live in the caller.
-bool write_png_file(std::FILE* f, const std::uint8_t* pixels, int width, int height,
-                    int channels, std::string* err) {
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, err, png_error_fn, png_warning_fn);
+bool write_png_file(std::FILE* f, const std::uint8_t* pixels, int width, int height, int channels,
+                    std::string* err) {
+  png_structp png =
+      png_create_write_struct(PNG_LIBPNG_VER_STRING, err, png_error_fn, png_warning_fn);
   if (!png) return false;
   png_infop info = png_create_info_struct(png);
   if (!info || setjmp(png_jmpbuf(png))) {
@@ -55,7 +56,8 @@ bool write_png_file(std::FILE* f, const std::uint8_t* pixels, int width, int hei
 }
 
 bool read_png_file(std::FILE* f, Image* out, std::string* err) {
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, err, png_error_fn, png_warning_fn);
+  png_structp png =
+      png_create_read_struct(PNG_LIBPNG_VER_STRING, err, png_error_fn, png_warning_fn);
   if (!png) return false;
   png_infop info = png_create_info_struct(png);
   if (!info || setjmp(png_jmpbuf(png))) {
@@ -77,7 +79,8 @@ bool read_png_file(std::FILE* f, Image* out, std::string* err) {
   out->width = static_cast<int>(w);
   out->height = static_cast<int>(h);
   out->rgba.assign(static_cast<std::size_t>(w) * h * 4, 0);
-  for (png_uint_32 y = 0; y < h; ++y) png_read_row(png, out->pixel(0, static_cast<int>(y)), nullptr);
+  for (png_uint_32 y = 0; y < h; ++y)
+    png_read_row(png, out->pixel(0, static_cast<int>(y)), nullptr);
   png_read_end(png, nullptr);
   png_destroy_read_struct(&png, &info, nullptr);
   return true;
@@ -90,17 +93,24 @@ const unsigned char* glyph(char c) {
       {7, 4, 7, 1, 7}, {7, 4, 7, 5, 7}, {7, 1, 1, 1, 1}, {7, 5, 7, 5, 7}, {7, 5, 7, 1, 7}};
   static const unsigned char dash[5] = {0, 0, 7, 0, 0};
   static const unsigned char space[5] = {0, 0, 0, 0, 0};
-  static const unsigned char F[5] = {7, 4, 6, 4, 4}, R[5] = {6, 5, 6, 5, 5},
-                             A[5] = {2, 5, 7, 5, 5}, M[5] = {5, 7, 7, 5, 5}, E[5] = {7, 4, 6, 4, 7};
+  static const unsigned char F[5] = {7, 4, 6, 4, 4}, R[5] = {6, 5, 6, 5, 5}, A[5] = {2, 5, 7, 5, 5},
+                             M[5] = {5, 7, 7, 5, 5}, E[5] = {7, 4, 6, 4, 7};
   if (c >= '0' && c <= '9') return digits[c - '0'];
   switch (c) {
-    case '-': return dash;
-    case 'F': return F;
-    case 'R': return R;
-    case 'A': return A;
-    case 'M': return M;
-    case 'E': return E;
-    default: return space;
+    case '-':
+      return dash;
+    case 'F':
+      return F;
+    case 'R':
+      return R;
+    case 'A':
+      return A;
+    case 'M':
+      return M;
+    case 'E':
+      return E;
+    default:
+      return space;
   }
 }
 
@@ -163,7 +173,8 @@ Image read_png(const std::string& path) {
 Image downscale(const Image& in, int max_width) {
   if (in.width <= max_width) return in;
   const int w = max_width;
-  const int h = std::max(1, static_cast<int>(std::lround(static_cast<double>(in.height) * w / in.width)));
+  const int h =
+      std::max(1, static_cast<int>(std::lround(static_cast<double>(in.height) * w / in.width)));
   Image out(w, h);
   for (int y = 0; y < h; ++y) {
     const int y0 = y * in.height / h, y1 = std::max(y0 + 1, (y + 1) * in.height / h);
@@ -174,7 +185,8 @@ Image downscale(const Image& in, int max_width) {
         for (int xx = x0; xx < x1; ++xx)
           for (int c = 0; c < 4; ++c) sum[c] += in.pixel(xx, yy)[c];
       const unsigned n = static_cast<unsigned>((y1 - y0) * (x1 - x0));
-      for (int c = 0; c < 4; ++c) out.pixel(x, y)[c] = static_cast<std::uint8_t>((sum[c] + n / 2) / n);
+      for (int c = 0; c < 4; ++c)
+        out.pixel(x, y)[c] = static_cast<std::uint8_t>((sum[c] + n / 2) / n);
     }
   }
   return out;

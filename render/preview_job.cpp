@@ -55,8 +55,9 @@ PreviewJob::PreviewJob(const Scene& scene, PreviewJobOptions options)
   const int n = opt_.last_frame - opt_.first_frame + 1;
   for (int i = 0; i < std::min(n, kSheetTiles); ++i) {
     const int f = n <= kSheetTiles ? opt_.first_frame + i
-                                   : opt_.first_frame + static_cast<int>(std::lround(
-                                                            static_cast<double>(i) * (n - 1) / (kSheetTiles - 1)));
+                                   : opt_.first_frame +
+                                         static_cast<int>(std::lround(static_cast<double>(i) *
+                                                                      (n - 1) / (kSheetTiles - 1)));
     sheet_frames_.push_back(f);
   }
 }
@@ -69,7 +70,8 @@ std::string PreviewJob::image_path(int frame) const {
 
 bool PreviewJob::render_frame(int frame) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (!assembler_) assembler_ = std::make_unique<SceneAssembler>(scene_, opt_.outdir, opt_.framing_frame);
+  if (!assembler_)
+    assembler_ = std::make_unique<SceneAssembler>(scene_, opt_.outdir, opt_.framing_frame);
   PreviewScene ps;
   try {
     ps = assembler_->assemble(frame);
@@ -91,8 +93,8 @@ bool PreviewJob::render_frame(int frame) {
 int PreviewJob::finish() {
   const RenderSettings& rs = scene_.render;
   if (rs.contact_sheet && !sheet_tiles_.empty()) {
-    const int columns = sheet_tiles_.size() <= 4 ? static_cast<int>(sheet_tiles_.size())
-                        : sheet_tiles_.size() <= 9 ? 3
+    const int columns = sheet_tiles_.size() <= 4    ? static_cast<int>(sheet_tiles_.size())
+                        : sheet_tiles_.size() <= 9  ? 3
                         : sheet_tiles_.size() <= 16 ? 4
                                                     : 6;
     const std::string path = opt_.outdir + "/contact_sheet.png";
@@ -118,11 +120,27 @@ void PreviewJob::write_movie() {
   std::ostringstream fps;
   fps << scene_.shot.fps;
   const std::string tmp = target + ".tmp." + std::to_string(::getpid()) + ".mp4";
-  std::vector<std::string> args = {ffmpeg, "-y", "-nostdin", "-loglevel", "error", "-framerate", fps.str(),
-                                   "-start_number", std::to_string(opt_.first_frame), "-i",
-                                   opt_.outdir + "/" + printf_pattern(scene_.render.pattern), "-frames:v",
-                                   std::to_string(rendered_), "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2",
-                                   "-c:v", "libx264", "-pix_fmt", "yuv420p", "-crf", "18"};
+  std::vector<std::string> args = {ffmpeg,
+                                   "-y",
+                                   "-nostdin",
+                                   "-loglevel",
+                                   "error",
+                                   "-framerate",
+                                   fps.str(),
+                                   "-start_number",
+                                   std::to_string(opt_.first_frame),
+                                   "-i",
+                                   opt_.outdir + "/" + printf_pattern(scene_.render.pattern),
+                                   "-frames:v",
+                                   std::to_string(rendered_),
+                                   "-vf",
+                                   "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                                   "-c:v",
+                                   "libx264",
+                                   "-pix_fmt",
+                                   "yuv420p",
+                                   "-crf",
+                                   "18"};
   if (opt_.threads > 0) {
     args.push_back("-threads");
     args.push_back(std::to_string(opt_.threads));

@@ -14,12 +14,12 @@
 namespace shellmpm {
 
 struct PreviewJobOptions {
-  std::string outdir;       ///< where the caches are and the previews go
-  int first_frame = 1;      ///< the frames that will be rendered, in order
+  std::string outdir;   ///< where the caches are and the previews go
+  int first_frame = 1;  ///< the frames that will be rendered, in order
   int last_frame = 1;
-  int framing_frame = 1;    ///< the frame the automatic camera frames (see SceneAssembler)
-  int threads = 0;          ///< llvmpipe / Embree threads (0 = all cores); TBB: the caller
-  std::function<void(const std::string&)> log;    ///< progress and notes
+  int framing_frame = 1;  ///< the frame the automatic camera frames (see SceneAssembler)
+  int threads = 0;        ///< llvmpipe / Embree threads (0 = all cores); TBB: the caller
+  std::function<void(const std::string&)> log;  ///< progress and notes
 };
 
 class PreviewJob {

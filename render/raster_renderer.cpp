@@ -1,8 +1,11 @@
 #include "render/raster_renderer.h"
 
 #define GL_GLEXT_PROTOTYPES 1
+// glext.h needs the types osmesa.h (through gl.h) declares first.
+// clang-format off
 #include <GL/osmesa.h>
 #include <GL/glext.h>
+// clang-format on
 
 #include <algorithm>
 #include <cmath>
@@ -207,13 +210,11 @@ Eigen::Matrix4f ortho(float half_w, float half_h, float n, float f) {
 void check_gl(const char* where) {
   const GLenum e = glGetError();
   if (e != GL_NO_ERROR)
-    throw std::runtime_error(std::string("raster renderer: OpenGL error 0x") +
-                             [&] {
-                               char b[16];
-                               std::snprintf(b, sizeof b, "%04x", e);
-                               return std::string(b);
-                             }() +
-                             " in " + where);
+    throw std::runtime_error(std::string("raster renderer: OpenGL error 0x") + [&] {
+      char b[16];
+      std::snprintf(b, sizeof b, "%04x", e);
+      return std::string(b);
+    }() + " in " + where);
 }
 
 }  // namespace
@@ -271,13 +272,25 @@ RasterRenderer::RasterRenderer(int threads) : gl_(std::make_unique<Gl>()) {
   // llvmpipe reads these when the first context of the process creates its screen.
   if (threads > 0) setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
   setenv("GALLIUM_DRIVER", "llvmpipe", 0);
-  const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24,
-                         OSMESA_STENCIL_BITS, 0, OSMESA_ACCUM_BITS, 0,
-                         OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                         OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+  const int attribs[] = {OSMESA_FORMAT,
+                         OSMESA_RGBA,
+                         OSMESA_DEPTH_BITS,
+                         24,
+                         OSMESA_STENCIL_BITS,
+                         0,
+                         OSMESA_ACCUM_BITS,
+                         0,
+                         OSMESA_PROFILE,
+                         OSMESA_CORE_PROFILE,
+                         OSMESA_CONTEXT_MAJOR_VERSION,
+                         3,
+                         OSMESA_CONTEXT_MINOR_VERSION,
+                         3,
+                         0};
   gl_->ctx = OSMesaCreateContextAttribs(attribs, nullptr);
   if (!gl_->ctx)
-    throw std::runtime_error("raster renderer: cannot create an OpenGL 3.3 core context with OSMesa");
+    throw std::runtime_error(
+        "raster renderer: cannot create an OpenGL 3.3 core context with OSMesa");
   try {
     gl_->make_current();
     GLint max_samples = 1;
@@ -334,44 +347,41 @@ RasterRenderer::~RasterRenderer() {
   OSMesaDestroyContext(g.ctx);
 }
 
-int RasterRenderer::samples() const { return gl_->samples; }
+int RasterRenderer::samples() const {
+  return gl_->samples;
+}
 
-Image RasterRenderer::render(const PreviewScene& scene, const Camera& cam) {
-  Gl& g = *gl_;
-  g.make_current();
-  g.resize(cam.width, cam.height);
+namespace {
 
-  // Buffers for this frame (freed at the end: nothing accumulates across frames).
-  std::vector<GLuint> buffers;
-  auto upload = [&](GLenum target, const void* data, std::size_t bytes) {
-    GLuint b = 0;
-    glGenBuffers(1, &b);
-    glBindBuffer(target, b);
-    glBufferData(target, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
-    buffers.push_back(b);
-    return b;
-  };
-  struct MeshBuffers {
+/// The frame's vertex buffers (freed with it: nothing accumulates across frames).
+class FrameBuffers {
+ public:
+  struct Mesh {
     GLuint pos, nrm, idx;
     GLsizei count;
   };
-  std::vector<MeshBuffers> mb;
-  for (const RenderMesh& m : scene.meshes) {
-    MeshBuffers b{};
-    b.pos = upload(GL_ARRAY_BUFFER, m.positions.data(), m.positions.size() * sizeof(Vec3f));
-    b.nrm = upload(GL_ARRAY_BUFFER, m.normals.data(), m.normals.size() * sizeof(Vec3f));
-    b.idx = upload(GL_ELEMENT_ARRAY_BUFFER, m.triangles.data(),
-                   m.triangles.size() * sizeof(Eigen::Vector3i));
-    b.count = static_cast<GLsizei>(m.triangles.size() * 3);
-    mb.push_back(b);
+  explicit FrameBuffers(const PreviewScene& scene) {
+    for (const RenderMesh& m : scene.meshes) {
+      Mesh b{};
+      b.pos = upload(GL_ARRAY_BUFFER, m.positions.data(), m.positions.size() * sizeof(Vec3f));
+      b.nrm = upload(GL_ARRAY_BUFFER, m.normals.data(), m.normals.size() * sizeof(Vec3f));
+      b.idx = upload(GL_ELEMENT_ARRAY_BUFFER, m.triangles.data(),
+                     m.triangles.size() * sizeof(Eigen::Vector3i));
+      b.count = static_cast<GLsizei>(m.triangles.size() * 3);
+      meshes.push_back(b);
+    }
+    const RenderParticles& pts = scene.particles;
+    num_points = static_cast<GLsizei>(pts.positions.size());
+    points = pts.positions.empty() ? 0
+                                   : upload(GL_ARRAY_BUFFER, pts.positions.data(),
+                                            pts.positions.size() * sizeof(Vec3f));
   }
-  const RenderParticles& pts = scene.particles;
-  const GLuint pbuf =
-      pts.positions.empty()
-          ? 0
-          : upload(GL_ARRAY_BUFFER, pts.positions.data(), pts.positions.size() * sizeof(Vec3f));
-  glBindVertexArray(g.vao);
-  auto bind_mesh = [&](const MeshBuffers& b, bool normals) {
+  ~FrameBuffers() { glDeleteBuffers(static_cast<GLsizei>(buffers_.size()), buffers_.data()); }
+  FrameBuffers(const FrameBuffers&) = delete;
+  FrameBuffers& operator=(const FrameBuffers&) = delete;
+
+  void bind_mesh(std::size_t i, bool normals) const {
+    const Mesh& b = meshes[i];
     glBindBuffer(GL_ARRAY_BUFFER, b.pos);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
@@ -383,24 +393,56 @@ Image RasterRenderer::render(const PreviewScene& scene, const Camera& cam) {
       glDisableVertexAttribArray(1);
     }
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, b.idx);
-  };
-  auto bind_points = [&] {
-    glBindBuffer(GL_ARRAY_BUFFER, pbuf);
+  }
+  void draw_mesh(std::size_t i, bool normals) const {
+    bind_mesh(i, normals);
+    glDrawElements(GL_TRIANGLES, meshes[i].count, GL_UNSIGNED_INT, nullptr);
+  }
+  void draw_points() const {
+    glBindBuffer(GL_ARRAY_BUFFER, points);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
     glDisableVertexAttribArray(1);
-  };
+    glDrawArrays(GL_POINTS, 0, num_points);
+  }
 
-  // Shadow map: orthographic from the key light over the content bounds.
+  std::vector<Mesh> meshes;
+  GLuint points = 0;  ///< 0 when there are no particles
+  GLsizei num_points = 0;
+
+ private:
+  GLuint upload(GLenum target, const void* data, std::size_t bytes) {
+    GLuint b = 0;
+    glGenBuffers(1, &b);
+    glBindBuffer(target, b);
+    glBufferData(target, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
+    buffers_.push_back(b);
+    return b;
+  }
+  std::vector<GLuint> buffers_;
+};
+
+/// The key light's orthographic view of the content bounds, for the shadow map.
+struct ShadowView {
+  Eigen::Matrix4f vp;
+  float px_per_m;  ///< shadow-map pixels per metre
+};
+
+ShadowView shadow_view(const PreviewScene& scene) {
   const Vec3f lo = scene.bounds_lo, hi = scene.bounds_hi;
   const Vec3f center = 0.5f * (lo + hi);
   const float radius = std::max(0.5f * (hi - lo).norm(), 1e-3f);
   const Vec3f kd = scene.lights.key_dir.normalized();
   const Vec3f up_hint = std::abs(kd.y()) > 0.99f ? Vec3f(0, 0, 1) : Vec3f(0, 1, 0);
-  const Eigen::Matrix4f light_vp =
-      ortho(radius, radius, radius, 3.0f * radius) * look_at(center + 2.0f * radius * kd, center, up_hint);
-  const float light_px_per_m = kShadowSize / (2.0f * radius);
-  glBindFramebuffer(GL_FRAMEBUFFER, g.shadow_fbo);
+  return {ortho(radius, radius, radius, 3.0f * radius) *
+              look_at(center + 2.0f * radius * kd, center, up_hint),
+          kShadowSize / (2.0f * radius)};
+}
+
+/// Renders the shadow casters' depth from the key light into `fbo`.
+void shadow_pass(GLuint fbo, GLuint depth_prog, const PreviewScene& scene, const FrameBuffers& fb,
+                 const ShadowView& light) {
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, kShadowSize, kShadowSize);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -409,42 +451,26 @@ Image RasterRenderer::render(const PreviewScene& scene, const Camera& cam) {
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(2.0f, 4.0f);
   glEnable(GL_PROGRAM_POINT_SIZE);
-  glUseProgram(g.depth_prog);
-  glUniformMatrix4fv(glGetUniformLocation(g.depth_prog, "u_vp"), 1, GL_FALSE, light_vp.data());
-  glUniform1i(glGetUniformLocation(g.depth_prog, "u_points"), 0);
+  glUseProgram(depth_prog);
+  glUniformMatrix4fv(glGetUniformLocation(depth_prog, "u_vp"), 1, GL_FALSE, light.vp.data());
+  glUniform1i(glGetUniformLocation(depth_prog, "u_points"), 0);
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     if (scene.meshes[i].kind == SurfaceKind::Ground) continue;  // receives, never casts
-    bind_mesh(mb[i], false);
-    glDrawElements(GL_TRIANGLES, mb[i].count, GL_UNSIGNED_INT, nullptr);
+    fb.draw_mesh(i, false);
   }
-  if (pbuf) {
-    glUniform1i(glGetUniformLocation(g.depth_prog, "u_points"), 1);
-    glUniform1f(glGetUniformLocation(g.depth_prog, "u_point_px"), 2.0f * pts.radius * light_px_per_m);
-    bind_points();
-    glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(pts.positions.size()));
+  if (fb.points) {
+    glUniform1i(glGetUniformLocation(depth_prog, "u_points"), 1);
+    glUniform1f(glGetUniformLocation(depth_prog, "u_point_px"),
+                2.0f * scene.particles.radius * light.px_per_m);
+    fb.draw_points();
   }
   glDisable(GL_POLYGON_OFFSET_FILL);
   check_gl("shadow pass");
+}
 
-  // Main pass, multisampled.
-  glBindFramebuffer(GL_FRAMEBUFFER, g.ms_fbo);
-  glViewport(0, 0, cam.width, cam.height);
-  glClearColor(0, 0, 0, 0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  const float h = static_cast<float>(cam.height);
-  auto set_common = [&](GLuint p) {
-    glUseProgram(p);
-    auto loc = [&](const char* n) { return glGetUniformLocation(p, n); };
-    glUniform3fv(loc("u_bg_top"), 1, scene.bg_top.data());
-    glUniform3fv(loc("u_bg_bottom"), 1, scene.bg_bottom.data());
-    glUniform1f(loc("u_height"), h);
-  };
-  glDisable(GL_DEPTH_TEST);
-  set_common(g.bg_prog);
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  glEnable(GL_DEPTH_TEST);
-
-  // Depth range from the content and the ground around it.
+/// The camera's view-projection, its depth range from the content and the ground around it.
+Eigen::Matrix4f camera_view_projection(const PreviewScene& scene, const Camera& cam) {
+  const Vec3f lo = scene.bounds_lo, hi = scene.bounds_hi;
   double z_far = 1e-3;
   const Vec3d eye = cam.eye;
   for (int c = 0; c < 8; ++c) {
@@ -454,72 +480,112 @@ Image RasterRenderer::render(const PreviewScene& scene, const Camera& cam) {
   z_far = std::max(z_far, (scene.ground.center.cast<double>() - eye).norm() + scene.ground.radius);
   z_far *= 1.05;
   const double z_near = z_far * 2e-4;
-  const Eigen::Matrix4f vp = cam.projection_matrix(z_near, z_far) * cam.view_matrix();
-  const Vec3f eye_f = eye.cast<float>();
-  const Vec3f right_f = cam.right().cast<float>(), up_f = cam.up().cast<float>();
-  const Vec3f fill_d = scene.lights.fill_dir.normalized();
-  auto set_lights = [&](GLuint p) {
-    set_common(p);
-    auto loc = [&](const char* n) { return glGetUniformLocation(p, n); };
-    glUniformMatrix4fv(loc("u_vp"), 1, GL_FALSE, vp.data());
-    glUniformMatrix4fv(loc("u_light_vp"), 1, GL_FALSE, light_vp.data());
-    glUniform3fv(loc("u_eye"), 1, eye_f.data());
-    glUniform3fv(loc("u_key_dir"), 1, kd.data());
-    glUniform3fv(loc("u_fill_dir"), 1, fill_d.data());
-    glUniform1f(loc("u_key"), scene.lights.key);
-    glUniform1f(loc("u_fill"), scene.lights.fill);
-    glUniform1f(loc("u_ambient"), scene.lights.ambient);
-    glUniform1f(loc("u_shadow_texel"), 1.0f / kShadowSize);
-    glUniform1f(loc("u_normal_bias"), 1.5f / light_px_per_m);
-    glUniform1i(loc("u_shadow"), 0);
-  };
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, g.shadow_tex);
-  set_lights(g.mesh_prog);
-  {
-    auto loc = [&](const char* n) { return glGetUniformLocation(g.mesh_prog, n); };
-    glUniform3fv(loc("u_ground_center"), 1, scene.ground.center.data());
-    glUniform1f(loc("u_ground_radius"), scene.ground.radius);
-    glUniform1f(loc("u_tile"), scene.ground.tile);
-    for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
-      const RenderMesh& m = scene.meshes[i];
-      glUniform1i(loc("u_kind"), static_cast<int>(m.kind));
-      glUniform3fv(loc("u_front"), 1, m.front.data());
-      glUniform3fv(loc("u_back"), 1, m.back.data());
-      bind_mesh(mb[i], true);
-      glDrawElements(GL_TRIANGLES, mb[i].count, GL_UNSIGNED_INT, nullptr);
-    }
-  }
-  if (pbuf) {
-    set_lights(g.point_prog);
-    auto loc = [&](const char* n) { return glGetUniformLocation(g.point_prog, n); };
-    glUniform3fv(loc("u_front"), 1, pts.color.data());
-    glUniform3fv(loc("u_cam_right"), 1, right_f.data());
-    glUniform3fv(loc("u_cam_up"), 1, up_f.data());
-    glUniform1f(loc("u_radius"), pts.radius);
-    glUniform1f(loc("u_px_scale"), static_cast<float>(0.5 * cam.height / cam.tan_half_fov()));
-    bind_points();
-    glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(pts.positions.size()));
-  }
-  check_gl("main pass");
+  return cam.projection_matrix(z_near, z_far) * cam.view_matrix();
+}
 
-  // Resolve and read back (OpenGL rows are bottom-up).
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, g.ms_fbo);
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.resolve_fbo);
-  glBlitFramebuffer(0, 0, cam.width, cam.height, 0, 0, cam.width, cam.height, GL_COLOR_BUFFER_BIT,
-                    GL_NEAREST);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, g.resolve_fbo);
+/// Sets the uniforms every main-pass program shares: background, lights, shadow map.
+void set_lights(GLuint p, const PreviewScene& scene, const Camera& cam, const Eigen::Matrix4f& vp,
+                const ShadowView& light) {
+  glUseProgram(p);
+  auto loc = [&](const char* n) { return glGetUniformLocation(p, n); };
+  glUniform3fv(loc("u_bg_top"), 1, scene.bg_top.data());
+  glUniform3fv(loc("u_bg_bottom"), 1, scene.bg_bottom.data());
+  glUniform1f(loc("u_height"), static_cast<float>(cam.height));
+  const Vec3f eye_f = cam.eye.cast<float>();
+  const Vec3f kd = scene.lights.key_dir.normalized();
+  const Vec3f fill_d = scene.lights.fill_dir.normalized();
+  glUniformMatrix4fv(loc("u_vp"), 1, GL_FALSE, vp.data());
+  glUniformMatrix4fv(loc("u_light_vp"), 1, GL_FALSE, light.vp.data());
+  glUniform3fv(loc("u_eye"), 1, eye_f.data());
+  glUniform3fv(loc("u_key_dir"), 1, kd.data());
+  glUniform3fv(loc("u_fill_dir"), 1, fill_d.data());
+  glUniform1f(loc("u_key"), scene.lights.key);
+  glUniform1f(loc("u_fill"), scene.lights.fill);
+  glUniform1f(loc("u_ambient"), scene.lights.ambient);
+  glUniform1f(loc("u_shadow_texel"), 1.0f / kShadowSize);
+  glUniform1f(loc("u_normal_bias"), 1.5f / light.px_per_m);
+  glUniform1i(loc("u_shadow"), 0);
+}
+
+/// Draws the meshes (mesh_prog) and the particles (point_prog), lit and shadowed.
+void draw_lit(GLuint mesh_prog, GLuint point_prog, const PreviewScene& scene, const Camera& cam,
+              const FrameBuffers& fb, const ShadowView& light) {
+  const Eigen::Matrix4f vp = camera_view_projection(scene, cam);
+  set_lights(mesh_prog, scene, cam, vp, light);
+  auto loc = [&](const char* n) { return glGetUniformLocation(mesh_prog, n); };
+  glUniform3fv(loc("u_ground_center"), 1, scene.ground.center.data());
+  glUniform1f(loc("u_ground_radius"), scene.ground.radius);
+  glUniform1f(loc("u_tile"), scene.ground.tile);
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const RenderMesh& m = scene.meshes[i];
+    glUniform1i(loc("u_kind"), static_cast<int>(m.kind));
+    glUniform3fv(loc("u_front"), 1, m.front.data());
+    glUniform3fv(loc("u_back"), 1, m.back.data());
+    fb.draw_mesh(i, true);
+  }
+  if (!fb.points) return;
+  const RenderParticles& pts = scene.particles;
+  set_lights(point_prog, scene, cam, vp, light);
+  auto ploc = [&](const char* n) { return glGetUniformLocation(point_prog, n); };
+  const Vec3f right_f = cam.right().cast<float>(), up_f = cam.up().cast<float>();
+  glUniform3fv(ploc("u_front"), 1, pts.color.data());
+  glUniform3fv(ploc("u_cam_right"), 1, right_f.data());
+  glUniform3fv(ploc("u_cam_up"), 1, up_f.data());
+  glUniform1f(ploc("u_radius"), pts.radius);
+  glUniform1f(ploc("u_px_scale"), static_cast<float>(0.5 * cam.height / cam.tan_half_fov()));
+  fb.draw_points();
+}
+
+/// Resolves the multisampled buffer and reads it back top row first (OpenGL's rows are
+/// bottom-up).
+Image read_back(GLuint ms_fbo, GLuint resolve_fbo, int width, int height) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
+  glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  Image out(cam.width, cam.height);
+  Image out(width, height);
   std::vector<std::uint8_t> rows(out.rgba.size());
-  glReadPixels(0, 0, cam.width, cam.height, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
   check_gl("read back");
-  const std::size_t stride = static_cast<std::size_t>(cam.width) * 4;
-  for (int y = 0; y < cam.height; ++y)
-    std::copy_n(rows.data() + static_cast<std::size_t>(cam.height - 1 - y) * stride, stride,
+  const std::size_t stride = static_cast<std::size_t>(width) * 4;
+  for (int y = 0; y < height; ++y)
+    std::copy_n(rows.data() + static_cast<std::size_t>(height - 1 - y) * stride, stride,
                 out.rgba.data() + static_cast<std::size_t>(y) * stride);
-  glBindVertexArray(0);
-  glDeleteBuffers(static_cast<GLsizei>(buffers.size()), buffers.data());
+  return out;
+}
+
+}  // namespace
+
+Image RasterRenderer::render(const PreviewScene& scene, const Camera& cam) {
+  Gl& g = *gl_;
+  g.make_current();
+  g.resize(cam.width, cam.height);
+  Image out;
+  {
+    const FrameBuffers fb(scene);
+    glBindVertexArray(g.vao);
+    const ShadowView light = shadow_view(scene);
+    shadow_pass(g.shadow_fbo, g.depth_prog, scene, fb, light);
+    // Main pass, multisampled: the background, then the lit content.
+    glBindFramebuffer(GL_FRAMEBUFFER, g.ms_fbo);
+    glViewport(0, 0, cam.width, cam.height);
+    glClearColor(0, 0, 0, 0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glDisable(GL_DEPTH_TEST);
+    glUseProgram(g.bg_prog);
+    glUniform3fv(glGetUniformLocation(g.bg_prog, "u_bg_top"), 1, scene.bg_top.data());
+    glUniform3fv(glGetUniformLocation(g.bg_prog, "u_bg_bottom"), 1, scene.bg_bottom.data());
+    glUniform1f(glGetUniformLocation(g.bg_prog, "u_height"), static_cast<float>(cam.height));
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glEnable(GL_DEPTH_TEST);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, g.shadow_tex);
+    draw_lit(g.mesh_prog, g.point_prog, scene, cam, fb, light);
+    check_gl("main pass");
+    out = read_back(g.ms_fbo, g.resolve_fbo, cam.width, cam.height);
+    glBindVertexArray(0);
+  }
   glFinish();
   return out;
 }

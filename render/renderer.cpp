@@ -7,10 +7,9 @@
 
 namespace shellmpm {
 
-std::unique_ptr<Renderer> make_renderer(const std::string& kind, int threads) {
-  if (kind == "raster") return std::make_unique<RasterRenderer>(threads);
-  if (kind == "raytrace") return std::make_unique<RayTracer>(threads);
-  throw std::invalid_argument("unknown renderer '" + kind + "' (expected raster or raytrace)");
+std::unique_ptr<Renderer> make_renderer(RendererKind kind, int threads) {
+  if (kind == RendererKind::Raytrace) return std::make_unique<RayTracer>(threads);
+  return std::make_unique<RasterRenderer>(threads);
 }
 
 }  // namespace shellmpm

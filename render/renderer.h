@@ -21,6 +21,7 @@
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/preview_scene.h"
+#include "sim/scene/scene.h"
 
 namespace shellmpm {
 
@@ -39,6 +40,6 @@ class Renderer {
 /// build threads ("threads=N"); the caller limits TBB (ThreadLimit) for the pixel loops.
 /// @throws std::invalid_argument for another name; std::runtime_error when the GL context
 ///         or Embree device cannot be created.
-std::unique_ptr<Renderer> make_renderer(const std::string& kind, int threads);
+std::unique_ptr<Renderer> make_renderer(RendererKind kind, int threads);
 
 }  // namespace shellmpm

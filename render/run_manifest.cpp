@@ -16,7 +16,9 @@ constexpr const char* kFormat = "shellmpm run manifest";
 constexpr int kVersion = 1;
 }  // namespace
 
-std::string run_manifest_path(const std::string& outdir) { return outdir + "/run.json"; }
+std::string run_manifest_path(const std::string& outdir) {
+  return outdir + "/run.json";
+}
 
 void write_run_manifest(const std::string& outdir, const RunManifest& m) {
   nlohmann::json j;
@@ -33,7 +35,8 @@ RunManifest read_run_manifest(const std::string& outdir) {
   const std::string path = run_manifest_path(outdir);
   std::error_code ec;
   if (!std::filesystem::is_directory(outdir, ec))
-    throw UserError(outdir, 0, "", "no such directory (give the output directory of a `shellmpm run`)");
+    throw UserError(outdir, 0, "",
+                    "no such directory (give the output directory of a `shellmpm run`)");
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw UserError(path, 0, "",

@@ -9,12 +9,14 @@
 
 #include "io/atomic_file.h"
 #include "io/mesh_reader.h"
+#include "io/ply_reader.h"
 #include "io/user_error.h"
 #include "render/particle_culling.h"
-#include "render/ply_reader.h"
 #include "render/tessellate.h"
 #include "sim/collider/collider.h"
 #include "sim/collider/shape_sdf.h"
+#include "sim/core/check.h"
+#include "sim/scene/scene_words.h"
 
 namespace shellmpm {
 namespace {
@@ -30,7 +32,9 @@ struct Box {
   }
 };
 
-Vec3f to_f(const Vec3d& v) { return v.cast<float>(); }
+Vec3f to_f(const Vec3d& v) {
+  return v.cast<float>();
+}
 
 constexpr std::size_t kMaxDenseVoxels = std::size_t(32) << 20;
 
@@ -65,14 +69,17 @@ RenderVolume dense_volume(const openvdb::FloatGrid& grid) {
   const openvdb::Coord dim = bb.dim();
   const double count = static_cast<double>(dim.x() + 2) * (dim.y() + 2) * (dim.z() + 2);
   const int f = std::max(1, static_cast<int>(std::ceil(std::cbrt(count / kMaxDenseVoxels))));
-  v.dims = Eigen::Vector3i((dim.x() + f - 1) / f + 2, (dim.y() + f - 1) / f + 2, (dim.z() + f - 1) / f + 2);
+  v.dims = Eigen::Vector3i((dim.x() + f - 1) / f + 2, (dim.y() + f - 1) / f + 2,
+                           (dim.z() + f - 1) / f + 2);
   const double h = grid.voxelSize()[0];
   v.voxel = static_cast<float>(h * f);
   // Dense sample (i, j, k) averages index voxels bb.min + (i-1, j-1, k-1) * f + [0, f)^3; its
   // center in world space:
-  const openvdb::Vec3d c0 = grid.indexToWorld(openvdb::Vec3d(bb.min().x(), bb.min().y(), bb.min().z()) +
-                                              openvdb::Vec3d(0.5 * (f - 1)) - openvdb::Vec3d(f));
-  v.origin = Vec3f(static_cast<float>(c0.x()), static_cast<float>(c0.y()), static_cast<float>(c0.z()));
+  const openvdb::Vec3d c0 =
+      grid.indexToWorld(openvdb::Vec3d(bb.min().x(), bb.min().y(), bb.min().z()) +
+                        openvdb::Vec3d(0.5 * (f - 1)) - openvdb::Vec3d(f));
+  v.origin =
+      Vec3f(static_cast<float>(c0.x()), static_cast<float>(c0.y()), static_cast<float>(c0.z()));
   v.density.assign(static_cast<std::size_t>(v.dims.x()) * v.dims.y() * v.dims.z(), 0.0f);
   const float w = 1.0f / static_cast<float>(f * f * f);
   for (auto it = grid.cbeginValueOn(); it; ++it) {
@@ -82,7 +89,8 @@ RenderVolume dense_volume(const openvdb::FloatGrid& grid) {
     for (int z = vb.min().z(); z <= vb.max().z(); ++z)
       for (int y = vb.min().y(); y <= vb.max().y(); ++y)
         for (int x = vb.min().x(); x <= vb.max().x(); ++x) {
-          const int i = (x - bb.min().x()) / f + 1, j = (y - bb.min().y()) / f + 1, k = (z - bb.min().z()) / f + 1;
+          const int i = (x - bb.min().x()) / f + 1, j = (y - bb.min().y()) / f + 1,
+                    k = (z - bb.min().z()) / f + 1;
           v.density[(static_cast<std::size_t>(k) * v.dims.y() + j) * v.dims.x() + i] += val;
         }
   }
@@ -101,10 +109,13 @@ RenderMesh iso_surface(const openvdb::FloatGrid& grid, double iso) {
   for (const openvdb::Vec3s& p : points) m.positions.emplace_back(p.x(), p.y(), p.z());
   m.triangles.reserve(tris.size() + 2 * quads.size());
   for (const openvdb::Vec3I& t : tris)
-    m.triangles.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]), static_cast<int>(t[2]));
+    m.triangles.emplace_back(static_cast<int>(t[0]), static_cast<int>(t[1]),
+                             static_cast<int>(t[2]));
   for (const openvdb::Vec4I& q : quads) {
-    m.triangles.emplace_back(static_cast<int>(q[0]), static_cast<int>(q[1]), static_cast<int>(q[2]));
-    m.triangles.emplace_back(static_cast<int>(q[0]), static_cast<int>(q[2]), static_cast<int>(q[3]));
+    m.triangles.emplace_back(static_cast<int>(q[0]), static_cast<int>(q[1]),
+                             static_cast<int>(q[2]));
+    m.triangles.emplace_back(static_cast<int>(q[0]), static_cast<int>(q[2]),
+                             static_cast<int>(q[3]));
   }
   m.normals = vertex_normals(m.positions, m.triangles);
   return m;
@@ -114,7 +125,8 @@ RenderMesh iso_surface(const openvdb::FloatGrid& grid, double iso) {
 RenderMesh shape_mesh_file(const ShapeDesc& s) {
   const TriMesh tm = read_mesh(s.mesh_path, s.mesh_where.empty() ? s.mesh_path : s.mesh_where);
   RenderMesh m;
-  for (const Vec3d& v : tm.vertices) m.positions.push_back(to_f(v * s.mesh_scale + s.mesh_translate));
+  for (const Vec3d& v : tm.vertices)
+    m.positions.push_back(to_f(v * s.mesh_scale + s.mesh_translate));
   m.triangles = tm.triangles;
   m.normals = vertex_normals(m.positions, m.triangles);
   return m;
@@ -129,15 +141,20 @@ RenderMesh posed(const RenderMesh& local, const RigidPose& pose) {
   return m;
 }
 
-double nice_tile(double radius) { return std::pow(10.0, std::floor(std::log10(std::max(radius, 1e-6)))); }
+double nice_tile(double radius) {
+  return std::pow(10.0, std::floor(std::log10(std::max(radius, 1e-6))));
+}
 
 }  // namespace
 
 Vec3d default_bulk_color(MaterialKind kind) {
   switch (kind) {
-    case MaterialKind::Sand: return {0.76, 0.60, 0.38};
-    case MaterialKind::Snow: return {0.92, 0.93, 0.96};
-    case MaterialKind::Elastic: break;
+    case MaterialKind::Sand:
+      return {0.76, 0.60, 0.38};
+    case MaterialKind::Snow:
+      return {0.92, 0.93, 0.96};
+    case MaterialKind::Elastic:
+      break;
   }
   return {0.36, 0.70, 0.30};
 }
@@ -149,34 +166,36 @@ SceneAssembler::SceneAssembler(const Scene& scene, std::string outdir, int frami
   const OutputSettings& out = scene.output;
   const bool has_bulk = !scene.sources.empty();
   // How the bulk material is drawn.
+  // The reader refused a drawing whose cache the run does not write (io/scene_reader.cpp).
   bulk_ = rs.bulk;
-  if (bulk_ == "auto") {
-    if (!has_bulk) bulk_ = "none";
-    else if (rs.renderer == "raytrace") bulk_ = out.density ? "volume" : out.particles ? "particles" : "none";
-    else bulk_ = out.particles ? "particles" : out.density ? "surface" : "none";
+  if (bulk_ == BulkDraw::Auto) {
+    if (rs.renderer == RendererKind::Raytrace)
+      bulk_ = out.density ? BulkDraw::Volume : out.particles ? BulkDraw::Particles : BulkDraw::None;
+    else
+      bulk_ = out.particles ? BulkDraw::Particles
+              : out.density ? BulkDraw::Surface
+                            : BulkDraw::None;
   }
-  if (bulk_ == "volume" && rs.renderer == "raster") bulk_ = "surface";
-  if (!has_bulk) bulk_ = "none";
-  if ((bulk_ == "volume" || bulk_ == "surface") && !out.density)
-    throw UserError(scene.path, 0, "render.bulk",
-                    "'" + rs.bulk + "' draws the density volume, but the run writes none (output.density: false)");
-  if (bulk_ == "particles" && !out.particles)
-    throw UserError(scene.path, 0, "render.bulk",
-                    "'particles' draws the particle cache, but the run writes none (set output.particles: true)");
+  if (bulk_ == BulkDraw::Volume && rs.renderer == RendererKind::Raster) bulk_ = BulkDraw::Surface;
+  if (!has_bulk) bulk_ = BulkDraw::None;
+  SHELLMPM_CHECK((bulk_ != BulkDraw::Volume && bulk_ != BulkDraw::Surface) || out.density,
+                 "render.bulk draws a density volume the run does not write");
+  SHELLMPM_CHECK(bulk_ != BulkDraw::Particles || out.particles,
+                 "render.bulk draws a particle cache the run does not write");
   if (has_bulk) {
     const SourceDesc& src = scene.sources.front();
     const MaterialDesc& mat = scene.materials[static_cast<std::size_t>(src.material)];
     bulk_color_ = to_f(mat.color ? *mat.color : default_bulk_color(mat.kind));
-    particle_radius_ = static_cast<float>(rs.particle_radius > 0
-                                              ? rs.particle_radius
-                                              : 0.5 * scene.shot.dx / std::cbrt(src.particles_per_cell));
+    particle_radius_ = static_cast<float>(
+        rs.particle_radius.value_or(0.5 * scene.shot.dx / std::cbrt(src.particles_per_cell)));
   }
 
   // Colliders, tessellated once in their own frame; the framing box.
   Box box;
   auto add_box = [&](const Vec3d& lo, const Vec3d& hi, const RigidPose& pose) {
     for (int c = 0; c < 8; ++c)
-      box.add(pose.apply(Vec3d(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z())));
+      box.add(pose.apply(
+          Vec3d(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z())));
   };
   for (const SourceDesc& src : scene.sources) {
     if (src.shape.kind == ShapeDesc::Kind::Mesh) {
@@ -202,7 +221,8 @@ SceneAssembler::SceneAssembler(const Scene& scene, std::string outdir, int frami
         ground_normal_ = n.normalized();
       }
     } else {
-      cm.local = c.shape.kind == ShapeDesc::Kind::Mesh ? shape_mesh_file(c.shape) : tessellate_shape(c.shape);
+      cm.local = c.shape.kind == ShapeDesc::Kind::Mesh ? shape_mesh_file(c.shape)
+                                                       : tessellate_shape(c.shape);
       Box local;
       for (const Vec3f& p : cm.local.positions) local.add(p.cast<double>());
       for (const RigidPose& p : poses) add_box(local.lo, local.hi, p);
@@ -233,7 +253,8 @@ SceneAssembler::SceneAssembler(const Scene& scene, std::string outdir, int frami
   }
   has_ground_ = rs.ground;
   if (has_ground_ && ground_collider_ < 0) {
-    ground_point_ = Vec3d(0.5 * (box.lo.x() + box.hi.x()), box.lo.y(), 0.5 * (box.lo.z() + box.hi.z()));
+    ground_point_ =
+        Vec3d(0.5 * (box.lo.x() + box.hi.x()), box.lo.y(), 0.5 * (box.lo.z() + box.hi.z()));
     ground_normal_ = Vec3d(0, 1, 0);
   }
   if (has_ground_) {
@@ -255,11 +276,7 @@ SceneAssembler::SceneAssembler(const Scene& scene, std::string outdir, int frami
   } else {
     auto it = std::find_if(rs.cameras.begin(), rs.cameras.end(),
                            [&](const RenderCamera& c) { return c.name == name; });
-    if (it == rs.cameras.end()) {
-      std::string names = "auto";
-      for (const RenderCamera& c : rs.cameras) names += ", " + c.name;
-      throw UserError(scene.path, 0, "render.camera", "unknown camera '" + name + "' (cameras: " + names + ")");
-    }
+    SHELLMPM_CHECK(it != rs.cameras.end(), "render.camera '" << name << "' (the reader checks it)");
     camera_.eye = it->position;
     camera_.target = it->target;
     camera_.up_hint = it->up;
@@ -284,7 +301,7 @@ RenderMesh SceneAssembler::read_shell(const ShellDesc& sh, int frame) const {
   RenderMesh m;
   m.name = sh.name;
   m.kind = SurfaceKind::Shell;
-  if (scene_.output.shell_format == "ply") {
+  if (scene_.output.shell_format == MeshFormat::Ply) {
     try {
       PlyMesh p = read_ply(path);
       m.positions = std::move(p.positions);
@@ -316,8 +333,10 @@ RenderMesh SceneAssembler::read_shell(const ShellDesc& sh, int frame) const {
 
 std::vector<std::string> SceneAssembler::files(int frame) const {
   std::vector<std::string> f;
-  if (bulk_ == "volume" || bulk_ == "surface") f.push_back(frame_path(outdir_, scene_.output.density_pattern, frame));
-  if (bulk_ == "particles") f.push_back(frame_path(outdir_, scene_.output.particles_pattern, frame));
+  if (bulk_ == BulkDraw::Volume || bulk_ == BulkDraw::Surface)
+    f.push_back(frame_path(outdir_, scene_.output.density_pattern, frame));
+  if (bulk_ == BulkDraw::Particles)
+    f.push_back(frame_path(outdir_, scene_.output.particles_pattern, frame));
   for (const ShellDesc& sh : scene_.shells)
     if (sh.write_mesh) f.push_back(shell_path(sh, frame));
   return f;
@@ -343,10 +362,10 @@ PreviewScene SceneAssembler::assemble(int frame) const {
     if (sh.write_mesh) add_mesh(read_shell(sh, frame));
 
   // Bulk material.
-  if (bulk_ == "volume" || bulk_ == "surface") {
+  if (bulk_ == BulkDraw::Volume || bulk_ == BulkDraw::Surface) {
     const std::string path = frame_path(outdir_, scene_.output.density_pattern, frame);
     openvdb::FloatGrid::Ptr grid = read_density_grid(path);
-    if (bulk_ == "surface") {
+    if (bulk_ == BulkDraw::Surface) {
       RenderMesh m = iso_surface(*grid, rs.iso_value);
       m.front = m.back = bulk_color_;
       if (!m.triangles.empty()) add_mesh(std::move(m));
@@ -356,10 +375,12 @@ PreviewScene SceneAssembler::assemble(int frame) const {
       ps.volume.color = bulk_color_;
       if (!ps.volume.empty()) {
         content.add(ps.volume.origin.cast<double>());
-        content.add((ps.volume.origin + (ps.volume.dims.cast<float>() - Vec3f::Ones()) * ps.volume.voxel).cast<double>());
+        content.add(
+            (ps.volume.origin + (ps.volume.dims.cast<float>() - Vec3f::Ones()) * ps.volume.voxel)
+                .cast<double>());
       }
     }
-  } else if (bulk_ == "particles") {
+  } else if (bulk_ == BulkDraw::Particles) {
     const std::string path = frame_path(outdir_, scene_.output.particles_pattern, frame);
     std::error_code ec;
     if (!fs::exists(path, ec)) throw CacheError(path, "missing (the run did not write this frame)");
@@ -423,7 +444,8 @@ PreviewScene SceneAssembler::assemble(int frame) const {
   if (back.norm() < 1e-9) back = -camera_.up();  // looking straight down
   back.normalize();
   const Vec3d right = up.cross(back).normalized();
-  const Vec3d key = rs.key_light ? *rs.key_light : (1.1 * up - 0.6 * right + 0.5 * back).normalized();
+  const Vec3d key =
+      rs.key_light ? *rs.key_light : (1.1 * up - 0.6 * right + 0.5 * back).normalized();
   ps.lights.key_dir = to_f(key.normalized());
   ps.lights.fill_dir = to_f((0.35 * up + 0.8 * right + 0.6 * back).normalized());
   ps.lights.key = 0.8f;

@@ -18,8 +18,8 @@ namespace shellmpm {
 
 /// Lit colour of a surface point (see the file comment). `shadow` is the key light's
 /// visibility in [0, 1], `ao` the sky's.
-inline Vec3f shade_surface(const RenderLights& l, const Vec3f& albedo, const Vec3f& n,
-                           float shadow, float ao) {
+inline Vec3f shade_surface(const RenderLights& l, const Vec3f& albedo, const Vec3f& n, float shadow,
+                           float ao) {
   const float sky = l.ambient * ao * (0.55f + 0.45f * n.y());
   const float key = l.key * shadow * std::max(0.0f, n.dot(l.key_dir));
   const float fill = l.fill * std::max(0.0f, n.dot(l.fill_dir));

@@ -53,9 +53,11 @@ RenderMesh tessellate_box(const Vec3d& lo, const Vec3d& hi) {
       }
       // (u, v) is right-handed around +axis: counter-clockwise seen from +axis.
       if (side)
-        m.triangles.emplace_back(base, base + 1, base + 2), m.triangles.emplace_back(base, base + 2, base + 3);
+        m.triangles.emplace_back(base, base + 1, base + 2),
+            m.triangles.emplace_back(base, base + 2, base + 3);
       else
-        m.triangles.emplace_back(base, base + 2, base + 1), m.triangles.emplace_back(base, base + 3, base + 2);
+        m.triangles.emplace_back(base, base + 2, base + 1),
+            m.triangles.emplace_back(base, base + 3, base + 2);
     }
   return m;
 }
@@ -137,7 +139,8 @@ RenderMesh tessellate_shape(const ShapeDesc& s) {
   }
 }
 
-std::vector<Vec3f> vertex_normals(const std::vector<Vec3f>& p, const std::vector<Eigen::Vector3i>& tris) {
+std::vector<Vec3f> vertex_normals(const std::vector<Vec3f>& p,
+                                  const std::vector<Eigen::Vector3i>& tris) {
   std::vector<Vec3f> n(p.size(), Vec3f::Zero());
   for (const Eigen::Vector3i& t : tris) {
     const Vec3f a = (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]);

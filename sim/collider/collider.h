@@ -31,7 +31,9 @@ class Collider {
   /// Signed distance at world x for the pose at the start of the step.
   double phi_start(const Vec3d& x) const { return shape_phi(desc_.shape, start_.apply_inverse(x)); }
   /// Outward unit normal at world x for the pose at the end of the step.
-  Vec3d normal(const Vec3d& x) const { return end_.R * shape_normal(desc_.shape, end_.apply_inverse(x)); }
+  Vec3d normal(const Vec3d& x) const {
+    return end_.R * shape_normal(desc_.shape, end_.apply_inverse(x));
+  }
   /// Where the collider point now at world x was at the start of the step.
   Vec3d start_of(const Vec3d& x) const { return start_.apply(end_.apply_inverse(x)); }
   /// Where the collider point at world x at the start of the step is at its end.

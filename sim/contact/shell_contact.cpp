@@ -15,8 +15,8 @@ constexpr Real kSeparationTolerance = Real(1e-6);
 
 }  // namespace
 
-ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& rest,
-                           double thickness, int samples, const ContactParams& params)
+ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& rest, double thickness,
+                           int samples, const ContactParams& params)
     : params_(params) {
   const TriangleQuadrature rule = triangle_quadrature(samples);
   const int nf = basis.num_faces();
@@ -146,7 +146,8 @@ double ShellContact::energy(const Vec3* ctrl, bool serial) const {
   return ordered_reduce(num_sites(), kGrain, serial, 0.0, [&](std::size_t p) {
     Vec3 a1, a2;
     tangents(ctrl, p, a1, a2);
-    return static_cast<double>(volume[p] * contact_gradient<Real>(a1, a2, a3e[p], params_, nullptr));
+    return static_cast<double>(volume[p] *
+                               contact_gradient<Real>(a1, a2, a3e[p], params_, nullptr));
   });
 }
 

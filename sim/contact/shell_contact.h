@@ -51,13 +51,13 @@ class ShellContact {
   void tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2) const;
 
   // Per site.
-  std::vector<Vec3> x;     ///< position (from the control points) [m]
-  std::vector<Vec3> a3e;   ///< elastic normal column
-  std::vector<Vec3> G3;    ///< dpsi/da3E from the last forces() call [Pa]
-  std::vector<Real> volume;  ///< rest volume [m^3]
+  std::vector<Vec3> x;              ///< position (from the control points) [m]
+  std::vector<Vec3> a3e;            ///< elastic normal column
+  std::vector<Vec3> G3;             ///< dpsi/da3E from the last forces() call [Pa]
+  std::vector<Real> volume;         ///< rest volume [m^3]
   std::vector<std::uint8_t> state;  ///< ContactState after the last return mapping
   // Per control point.
-  std::vector<Mat3> C;     ///< APIC affine velocity matrix [1/s]
+  std::vector<Mat3> C;  ///< APIC affine velocity matrix [1/s]
 
   // Site stencils (CSR): control points k in [off[p], off[p+1]).
   std::vector<std::uint32_t> off, idx;

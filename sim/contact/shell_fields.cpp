@@ -6,7 +6,7 @@
 
 #include "sim/contact/field_contact.h"
 #include "sim/core/parallel.h"
-#include "sim/mpm/bspline.h"
+#include "sim/mpm/apic_stencil.h"
 
 namespace shellmpm {
 namespace {
@@ -24,7 +24,7 @@ void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bul
 }
 
 ShellFields::PointShare::PointShare(const GridShell& gs, const Vec3& nj, const Vec3& f,
-                                   std::uint32_t j, Real dx, Real dt, bool with_heights)
+                                    std::uint32_t j, Real dx, Real dt, bool with_heights)
     : heights(with_heights),
       m(gs.shell->mass[j]),
       mh(gs.held[j] == 7 ? m : Real(0)),
@@ -86,14 +86,9 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
           for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
             const std::uint32_t j = F.grid.order[q];
             const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
-            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt,
-                               folds_);
-            const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-            for (int i = 0; i < 3; ++i)
-              for (int jj = 0; jj < 3; ++jj)
-                for (int k = 0; k < 3; ++k)
-                  P.add(buf[pad_node(lx + i, ly + jj, lz + k)], W.w[0][i] * W.w[1][jj] * W.w[2][k],
-                        i, jj, k);
+            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, folds_);
+            for_each_stencil_node(
+                W, bc, [&](const StencilNode& n) { P.add(buf[n.pad()], n.w, n.i, n.j, n.k); });
           }
         }
       },
@@ -114,9 +109,8 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
           auto& nodes = F.nodes[g];
           Node::clear(nodes.data(), nodes.size());
           F.r[g].fill(Vec3::Zero());
-          F.grid.for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
-            nodes[dn] += F.buf[src][sn];
-          });
+          F.grid.for_each_buffer_node(
+              g, [&](int dn, std::size_t src, int sn) { nodes[dn] += F.buf[src][sn]; });
           if (!folds_)
             for (Node& d : nodes) normalise(d);
         }
@@ -168,17 +162,14 @@ void ShellFields::bulk_moments(const SparseGrid& combined, const ParticleSet& bu
             const std::uint32_t p = o[q] - first_bulk;
             const QuadraticWeights W(combined.grid_coord(bulk.x[p]));
             const Real m = bulk.volume[p];  // volume-weighted: the densities cancel in a centroid
-            const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-            for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j)
-                for (int k = 0; k < 3; ++k) {
-                  const Real w = W.w[0][i] * W.w[1][j] * W.w[2][k] * m;
-                  Moment& nd = buf[pad_node(lx + i, ly + j, lz + k)];
-                  nd.m += w;
-                  nd.o[0] += w * (W.fx[0] - Real(i));
-                  nd.o[1] += w * (W.fx[1] - Real(j));
-                  nd.o[2] += w * (W.fx[2] - Real(k));
-                }
+            for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+              const Real w = n.w * m;
+              Moment& nd = buf[n.pad()];
+              nd.m += w;
+              nd.o[0] += w * (W.fx[0] - Real(n.i));
+              nd.o[1] += w * (W.fx[1] - Real(n.j));
+              nd.o[2] += w * (W.fx[2] - Real(n.k));
+            });
           }
         }
       },
@@ -397,27 +388,23 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
               const std::uint32_t j = F.grid.order[q];
               const QuadraticWeights W(F.grid.grid_coord(F.x0[j]));
               const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-              const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
               Vec3 dv = Vec3::Zero();
               Mat3 B = Mat3::Zero();
               bool any = false;
-              for (int i = 0; i < 3; ++i)
-                for (int jj = 0; jj < 3; ++jj)
-                  for (int k = 0; k < 3; ++k) {
-                    const int px = lx + i, py = ly + jj, pz = lz + k;
-                    const int o = (px >> 2) * 4 + (py >> 2) * 2 + (pz >> 2);
-                    const int bn = block_node(px & 3, py & 3, pz & 3);
-                    const int fi = folded ? F.fold[nbr[o]] : -1;
-                    // Where the shell folds, the control point reads its own class.
-                    const bool second = fi >= 0 && is_split(F.folds[fi], bn) &&
-                                        fold_height(F.normal[j], fx, i, jj, k) >= F.folds[fi].cut[bn];
-                    const Vec3& rn = second ? F.folds[fi].r[bn] : F.r[nbr[o]][bn];
-                    if (rn.isZero()) continue;
-                    any = true;
-                    const Real w = W.w[0][i] * W.w[1][jj] * W.w[2][k];
-                    dv += w * rn;
-                    B += (w * rn) * (Vec3(Real(i), Real(jj), Real(k)) - fx).transpose();
-                  }
+              for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+                const int o = (n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2);
+                const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
+                const int fi = folded ? F.fold[nbr[o]] : -1;
+                // Where the shell folds, the control point reads its own class.
+                const bool second =
+                    fi >= 0 && is_split(F.folds[fi], bn) &&
+                    fold_height(F.normal[j], fx, n.i, n.j, n.k) >= F.folds[fi].cut[bn];
+                const Vec3& rn = second ? F.folds[fi].r[bn] : F.r[nbr[o]][bn];
+                if (rn.isZero()) return;
+                any = true;
+                dv += n.w * rn;
+                B += (n.w * rn) * (Vec3(Real(n.i), Real(n.j), Real(n.k)) - fx).transpose();
+              });
               if (!any) continue;
               // Pinned components keep their prescribed velocity, but their affine matrix
               // still becomes the gradient of this shell's own field: left at the shared

@@ -9,7 +9,9 @@
 namespace shellmpm {
 namespace {
 
-Vec3d to_d(const Vec3& v) { return v.cast<double>(); }
+Vec3d to_d(const Vec3& v) {
+  return v.cast<double>();
+}
 
 /// Unique undirected edges of a triangle list, sorted.
 std::vector<Eigen::Vector2i> unique_edges(const std::vector<Eigen::Vector3i>& tris) {
@@ -69,8 +71,8 @@ void ShellGuard::setup(const std::vector<GridShell>& shells, double gap, bool se
   for (const GridShell& g : shells) {
     const ShellObject& sh = *g.shell;
     Mesh m;
-    m.limit = std::make_unique<LimitMesh>(sh.basis(), sh.triangles(),
-                                          std::vector<Eigen::Vector2d>{}, 0);
+    m.limit =
+        std::make_unique<LimitMesh>(sh.basis(), sh.triangles(), std::vector<Eigen::Vector2d>{}, 0);
     m.edges = unique_edges(m.limit->triangles());
     std::vector<Vec3> rest_x(sh.rest.size());
     for (std::size_t i = 0; i < rest_x.size(); ++i) rest_x[i] = sh.rest[i].cast<Real>();
@@ -86,8 +88,7 @@ void ShellGuard::setup(const std::vector<GridShell>& shells, double gap, bool se
     meshes_.push_back(std::move(m));
   }
   vert_shell_.clear();
-  for (std::size_t s = 0; s < meshes_.size(); ++s)
-    vert_shell_.resize(vertex_offset_[s + 1], s);
+  for (std::size_t s = 0; s < meshes_.size(); ++s) vert_shell_.resize(vertex_offset_[s + 1], s);
   shell_list_ = {};
   bulk_list_ = {};
   all_tris_.clear();
@@ -106,8 +107,8 @@ void ShellGuard::add_vertex(std::size_t s, int v, double scale) {
   const std::vector<int>& pts = L.row_points(static_cast<std::size_t>(v));
   const std::vector<Real>& w = L.row_weights(static_cast<std::size_t>(v));
   for (std::size_t k = 0; k < pts.size(); ++k)
-    entries_.push_back({point_offset_[s] + static_cast<std::size_t>(pts[k]),
-                        scale * static_cast<double>(w[k])});
+    entries_.push_back(
+        {point_offset_[s] + static_cast<std::size_t>(pts[k]), scale * static_cast<double>(w[k])});
 }
 
 void ShellGuard::add_pair(const Vec3d& n, double d, double dt) {
@@ -371,8 +372,8 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
 }
 
 ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
-                                  const std::vector<std::vector<Vec3>>& start, const GuardBulk& bulk,
-                                  double dt) {
+                                  const std::vector<std::vector<Vec3>>& start,
+                                  const GuardBulk& bulk, double dt) {
   ShellGuardStats st;
   if (meshes_.empty() || !(dt > 0)) return st;
   const std::size_t np = point_offset_.back(), nv = vertex_offset_.back();
@@ -401,7 +402,8 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   ParticleSet* const ps = bulk.particles;
   const std::size_t nb = ps ? ps->size() : 0;
   double vbulk = 0;
-  for (std::size_t p = 0; p < nb; ++p) vbulk = std::max(vbulk, static_cast<double>(ps->v[p].norm()));
+  for (std::size_t p = 0; p < nb; ++p)
+    vbulk = std::max(vbulk, static_cast<double>(ps->v[p].norm()));
   if (!std::isfinite(vmax) || !std::isfinite(vbulk)) return st;  // diverged: the solver says so
   // Relative motion bounds this step: shell against shell, bulk against shell.
   const double reach = 2.0 * vmax * dt, reach_bulk = dt * (vmax + vbulk);
@@ -410,13 +412,12 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   // left out within reach (a pair left out was at least gap + margin apart then), and
   // the bulk list also when the particles were reordered or added.
   const bool shell_rebuild = !shell_list_.valid(reach);
-  const bool bulk_rebuild = nb > 0 && (!bulk_list_.valid(reach_bulk) ||
-                                       bulk.epoch != built_epoch_ || nb != built_count_);
+  const bool bulk_rebuild =
+      nb > 0 && (!bulk_list_.valid(reach_bulk) || bulk.epoch != built_epoch_ || nb != built_count_);
   if (nb == 0) bt_cand_.clear(), bulk_idx_.clear();
   shell_list_.moved += reach;
   bulk_list_.moved += reach_bulk;
-  if (!shell_rebuild && !bulk_rebuild && vt_cand_.empty() && ee_cand_.empty() &&
-      bt_cand_.empty())
+  if (!shell_rebuild && !bulk_rebuild && vt_cand_.empty() && ee_cand_.empty() && bt_cand_.empty())
     return st;  // nothing near, and the lists still hold
   // Limit vertices at x^n.
   pos_.assign(nv, Vec3d::Zero());
@@ -427,7 +428,8 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
       const std::vector<int>& pts = L.row_points(row);
       const std::vector<Real>& w = L.row_weights(row);
       for (std::size_t k = 0; k < pts.size(); ++k)
-        pos_[g] += static_cast<double>(w[k]) * x0_[point_offset_[s] + static_cast<std::size_t>(pts[k])];
+        pos_[g] +=
+            static_cast<double>(w[k]) * x0_[point_offset_[s] + static_cast<std::size_t>(pts[k])];
     }
   }
   if (shell_rebuild) {

@@ -20,9 +20,10 @@
 // - Bulk particles are points of the same kind: a bulk particle closer than the gap to a
 //   limit triangle is a pair like a limit vertex (its mass from volume and density).
 // - Proximity pairs at x^n within gap + reach (reach = twice the largest limit speed
-//   times dt; candidates from lists rebuilt only when the motion needs it): vertex-triangle (a limit vertex not on the triangle) and edge-edge (edges
-//   without a common vertex), between shells and within a shell. Within a shell, pairs
-//   closer than about one mesh edge at rest are left out (see Mesh::near).
+//   times dt; candidates from lists rebuilt only when the motion needs it): vertex-triangle (a
+//   limit vertex not on the triangle) and edge-edge (edges without a common vertex), between shells
+//   and within a shell. Within a shell, pairs closer than about one mesh edge at rest are left out
+//   (see Mesh::near).
 // - Each pair is a one-sided constraint on the relative limit velocity along its normal
 //   n (from the closest point of the second feature to the first): with distance d,
 //   n . (u_1 - u_2) >= -max(d - gap, 0) / dt, i.e. the pair may close up to the gap but no
@@ -59,7 +60,7 @@ namespace shellmpm {
 struct GuardBulk {
   ParticleSet* particles = nullptr;
   const std::vector<Real>* densities = nullptr;  ///< per material [kg/m^3]
-  std::uint64_t epoch = 0;  ///< changes whenever the particles are reordered
+  std::uint64_t epoch = 0;                       ///< changes whenever the particles are reordered
 };
 
 /// What one guard pass did.
@@ -155,14 +156,14 @@ class ShellGuard {
   std::size_t built_count_ = 0;
   ListSchedule shell_list_, bulk_list_;
   // Per pass (kept to reuse their memory).
-  std::vector<Vec3d> pos_;               ///< limit vertices of all shells at x^n
-  std::vector<Vec3d> x0_;                ///< control points at x^n
-  std::vector<Vec3d> v_end_;             ///< (x - x^n) / dt before the guard
-  std::vector<Vec3d> v_;                 ///< control velocities (double) being corrected
-  std::vector<Vec3d> inv_mass_;          ///< per control point and component
+  std::vector<Vec3d> pos_;       ///< limit vertices of all shells at x^n
+  std::vector<Vec3d> x0_;        ///< control points at x^n
+  std::vector<Vec3d> v_end_;     ///< (x - x^n) / dt before the guard
+  std::vector<Vec3d> v_;         ///< control velocities (double) being corrected
+  std::vector<Vec3d> inv_mass_;  ///< per control point and component
   std::vector<Eigen::Vector3i> all_tris_;
   std::vector<Vec3d> edge_tri_pos_;
-  std::vector<Eigen::Vector3i> all_edges_;  ///< edges as degenerate triangles (a, b, b)
+  std::vector<Eigen::Vector3i> all_edges_;         ///< edges as degenerate triangles (a, b, b)
   TriangleGrid tri_grid_, edge_grid_, bulk_grid_;  ///< used by the list builds only
   std::vector<Entry> entries_;
   std::vector<Pair> pairs_;

@@ -6,6 +6,7 @@
 #include "sim/collider/collider.h"
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
+#include "sim/mpm/apic_stencil.h"
 
 namespace shellmpm {
 
@@ -25,7 +26,8 @@ void ShellPointTable::build(const std::vector<GridShell>& shells) {
     }
 }
 
-void ShellPointTable::positions(const std::vector<GridShell>& shells, std::vector<Vec3>& out) const {
+void ShellPointTable::positions(const std::vector<GridShell>& shells,
+                                std::vector<Vec3>& out) const {
   out.clear();
   out.reserve(size());
   for (const GridShell& g : shells) out.insert(out.end(), g.shell->x.begin(), g.shell->x.end());
@@ -40,7 +42,7 @@ void prescribe_pins(ShellObject& sh, double t, double dt, std::vector<std::uint8
   std::vector<char> released(d.pins.size());
   for (std::size_t p = 0; p < poses.size(); ++p) {
     poses[p] = keyframe_pose(d.pins[p].keyframes, t + dt);
-    released[p] = d.pins[p].release_time >= 0 && t >= d.pins[p].release_time;
+    released[p] = d.pins[p].release_time && t >= *d.pins[p].release_time;
   }
   const Real h = static_cast<Real>(dt);
   for (std::size_t i = 0; i < sh.size(); ++i) {
@@ -81,26 +83,7 @@ void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
     const QuadraticWeights W(grid.grid_coord(sh.x[j]));
     const Mat3 A = (m * dx) * gs.contact->C[j];  // world offset = dx (node - fx)
     const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-    const Vec3 base = m * sh.v[j] + dt * gs.force[j] - A * fx;
-    const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-    // Factored as in sim/mpm/transfer.cpp: A (node - fx) = A (-fx) + A.col(0) i + ...
-    for (int i = 0; i < 3; ++i) {
-      const Vec3 bi = base + Real(i) * A.col(0);
-      for (int jj = 0; jj < 3; ++jj) {
-        const Vec3 bij = bi + Real(jj) * A.col(1);
-        const Real wxy = W.w[0][i] * W.w[1][jj];
-        GridNode* row = &buf[pad_node(lx + i, ly + jj, lz)];
-        for (int k = 0; k < 3; ++k) {
-          const Real w = wxy * W.w[2][k];
-          const Vec3 mom = w * (bij + Real(k) * A.col(2));
-          GridNode& nd = row[k];
-          nd.m += w * m;
-          nd.v[0] += mom[0];
-          nd.v[1] += mom[1];
-          nd.v[2] += mom[2];
-        }
-      }
-    }
+    apic_scatter<false>(buf, W, bc, m, m * sh.v[j] + dt * gs.force[j] - A * fx, A, Mat3::Zero());
   }
 }
 
@@ -118,34 +101,9 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
     if (g < nc) {
       ShellObject& sh = *gs.shell;
       const QuadraticWeights W(grid.grid_coord(sh.x[j]));
-      const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-      // Sums of w v, w v i, w v j, w v k over the nodes, built per axis.
-      Vec3 v = Vec3::Zero(), vi_sum = Vec3::Zero(), vj_sum = Vec3::Zero(), vk_sum = Vec3::Zero();
-      for (int i = 0; i < 3; ++i) {
-        Vec3 P = Vec3::Zero(), Pj = Vec3::Zero(), Pk = Vec3::Zero();
-        for (int jj = 0; jj < 3; ++jj) {
-          const GridNode* row = &buf[pad_node(lx + i, ly + jj, lz)];
-          Vec3 Q = Vec3::Zero(), Qk = Vec3::Zero();
-          for (int k = 0; k < 3; ++k) {
-            const Vec3 wv = W.w[2][k] * Vec3(row[k].v[0], row[k].v[1], row[k].v[2]);
-            Q += wv;
-            Qk += Real(k) * wv;
-          }
-          P += W.w[1][jj] * Q;
-          Pj += (W.w[1][jj] * Real(jj)) * Q;
-          Pk += W.w[1][jj] * Qk;
-        }
-        v += W.w[0][i] * P;
-        vi_sum += (W.w[0][i] * Real(i)) * P;
-        vj_sum += W.w[0][i] * Pj;
-        vk_sum += W.w[0][i] * Pk;
-      }
-      // B = sum w v (node - fx)^T in grid units.
-      Mat3 B;
-      B.col(0) = vi_sum - W.fx[0] * v;
-      B.col(1) = vj_sum - W.fx[1] * v;
-      B.col(2) = vk_sum - W.fx[2] * v;
-      gs.contact->C[j] = (Real(4) / dx) * B;  // B D^-1 with B in grid units times dx
+      const ApicGather G = apic_gather<false>(buf, W, bc);
+      const Vec3& v = G.v;
+      gs.contact->C[j] = (Real(4) / dx) * G.B;  // B D^-1 with B in grid units times dx
       const std::uint8_t held = gs.held[j];
       for (int a = 0; a < 3; ++a)
         if (!(held & (1u << a))) sh.v[j][a] = v[a];
@@ -196,7 +154,9 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
             const std::uint32_t p = table.local(g);
             const Vec3& G3 = c.G3[p];
             if (G3.squaredNorm() == 0) continue;
-            auto at = [&](int i, int j, int k) { return pad_node(i - bc[0], j - bc[1], k - bc[2]); };
+            auto at = [&](int i, int j, int k) {
+              return pad_node(i - bc[0], j - bc[1], k - bc[2]);
+            };
             const SiteMoments sm =
                 site_moments(grid, c.x[p], [&](int i, int j, int k) { return mass[at(i, j, k)]; });
             if (!sm.any) continue;

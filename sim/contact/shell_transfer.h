@@ -30,8 +30,8 @@ namespace shellmpm {
 struct GridShell {
   ShellObject* shell = nullptr;
   ShellContact* contact = nullptr;
-  std::vector<Vec3> force;          ///< control-point forces this step (no gravity) [N]
-  std::vector<std::uint8_t> held;   ///< per control point: components prescribed by pins
+  std::vector<Vec3> force;         ///< control-point forces this step (no gravity) [N]
+  std::vector<std::uint8_t> held;  ///< per control point: components prescribed by pins
 };
 
 /// The shell points binned in front of the bulk particles: all control points of all

@@ -24,11 +24,11 @@ namespace detail {
 }  // namespace shellmpm
 
 /// SHELLMPM_CHECK(cond, stream-expression): throws InvariantError printing the values.
-#define SHELLMPM_CHECK(cond, ...)                                                    \
-  do {                                                                               \
-    if (!(cond)) {                                                                   \
-      std::ostringstream shellmpm_check_os_;                                         \
-      shellmpm_check_os_ << "" __VA_ARGS__;                                          \
+#define SHELLMPM_CHECK(cond, ...)                                                            \
+  do {                                                                                       \
+    if (!(cond)) {                                                                           \
+      std::ostringstream shellmpm_check_os_;                                                 \
+      shellmpm_check_os_ << "" __VA_ARGS__;                                                  \
       ::shellmpm::detail::check_failed(#cond, __FILE__, __LINE__, shellmpm_check_os_.str()); \
-    }                                                                                \
+    }                                                                                        \
   } while (0)

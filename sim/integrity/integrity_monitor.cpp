@@ -258,37 +258,46 @@ IntegrityReport IntegrityMonitor::snapshot(const IntegrityView& view) {
 
 void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityReport& r) const {
   r.active = true;
-  std::vector<IntegrityEvent> warnings;
   r.collider_limit = kColliderCells * dx_;
+  check_non_finite(view, r);
+  check_crossings(view, r);
+  std::vector<IntegrityEvent> warnings;
+  check_stretched(r, warnings);
+  if (view.colliders)
+    for (const Collider& c : *view.colliders) check_collider(view, c, r);
+  r.events.insert(r.events.end(), warnings.begin(), warnings.end());
+}
+
+/// Non-finite positions or velocities of bulk particles and control points.
+void IntegrityMonitor::check_non_finite(const IntegrityView& view, IntegrityReport& r) const {
   const std::size_t nb = view.bulk ? view.bulk->size() : 0;
-  // Non-finite state.
-  {
-    std::size_t bad = 0;
-    for (std::size_t p = 0; p < nb; ++p)
-      bad += !(view.bulk->x[p].allFinite() && view.bulk->v[p].allFinite());
-    if (bad) {
-      IntegrityEvent e;
-      e.kind = IntegrityEvent::Kind::NonFinite;
-      e.object = "bulk particles";
-      e.count = bad;
-      r.events.push_back(e);
-      r.non_finite += bad;
-    }
-    for (std::size_t s = 0; s < shells_.size(); ++s) {
-      const ShellObject& sh = *view.shells[s];
-      std::size_t b = 0;
-      for (std::size_t j = 0; j < sh.size(); ++j)
-        b += !(sh.x[j].allFinite() && sh.v[j].allFinite());
-      if (!b) continue;
-      IntegrityEvent e;
-      e.kind = IntegrityEvent::Kind::NonFinite;
-      e.object = names_[s];
-      e.count = b;
-      r.events.push_back(e);
-      r.non_finite += b;
-    }
+  std::size_t bad = 0;
+  for (std::size_t p = 0; p < nb; ++p)
+    bad += !(view.bulk->x[p].allFinite() && view.bulk->v[p].allFinite());
+  if (bad) {
+    IntegrityEvent e;
+    e.kind = IntegrityEvent::Kind::NonFinite;
+    e.object = "bulk particles";
+    e.count = bad;
+    r.events.push_back(e);
+    r.non_finite += bad;
   }
-  // Edges through triangles: every ordered pair of shells, self included.
+  for (std::size_t s = 0; s < shells_.size(); ++s) {
+    const ShellObject& sh = *view.shells[s];
+    std::size_t b = 0;
+    for (std::size_t j = 0; j < sh.size(); ++j) b += !(sh.x[j].allFinite() && sh.v[j].allFinite());
+    if (!b) continue;
+    IntegrityEvent e;
+    e.kind = IntegrityEvent::Kind::NonFinite;
+    e.object = names_[s];
+    e.count = b;
+    r.events.push_back(e);
+    r.non_finite += b;
+  }
+}
+
+/// Edges through triangles: every ordered pair of shells, self included.
+void IntegrityMonitor::check_crossings(const IntegrityView& view, IntegrityReport& r) const {
   const std::size_t K = shells_.size();
   for (std::size_t a = 0; a < K; ++a)
     for (std::size_t b = a; b < K; ++b) {
@@ -341,8 +350,13 @@ void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityRepo
       r.events.push_back(e);
       (a == b ? r.self_crossing_edges : r.shell_crossing_edges) += count;
     }
-  // Stretched meshes: a contact shell whose edges grew past 2 dx leaves gaps between its
-  // control points' kernels, through which contact can leak (a warning, not a failure).
+}
+
+/// Stretched meshes: a contact shell whose edges grew past 2 dx leaves gaps between its
+/// control points' kernels, through which contact can leak (a warning, not a failure).
+void IntegrityMonitor::check_stretched(IntegrityReport& r,
+                                       std::vector<IntegrityEvent>& warnings) const {
+  const std::size_t K = shells_.size();
   for (std::size_t s = 0; s < K; ++s) {
     const ShellGeom& g = shells_[s];
     std::size_t longer = 0;
@@ -367,57 +381,58 @@ void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityRepo
     warnings.push_back(e);
     r.stretched_edges += longer;
   }
-  // Colliders: bulk particles and shell limit vertices deeper than the limit.
-  if (view.colliders)
-    for (const Collider& c : *view.colliders) {
-      struct Deep {
-        std::size_t count = 0;
-        double depth = 0;
-        Vec3d where = Vec3d::Zero();
-      };
-      const std::size_t nv = vertex_offset_.back();
-      const std::size_t n = nv + nb;
-      const std::size_t chunks = (n + kGrain - 1) / kGrain;
-      std::vector<Deep> parts(chunks);
-      parallel_for(
-          n, kGrain,
-          [&](std::size_t b, std::size_t e) {
-            Deep& d = parts[b / kGrain];
-            std::size_t s = 0;
-            for (std::size_t i = b; i < e; ++i) {
-              const Vec3d x = point(view, i, s);
-              Aabb at;
-              at.lo = at.hi = x;
-              if (!x.allFinite() || !c.bounds().overlaps(at)) continue;
-              const double depth = -c.phi(x);
-              if (depth > d.depth) {
-                d.depth = depth;
-                d.where = x;
-              }
-              if (depth > r.collider_limit) ++d.count;
-            }
-          },
-          view.serial);
-      Deep total;
-      for (const Deep& d : parts) {
-        total.count += d.count;
-        if (d.depth > total.depth) {
-          total.depth = d.depth;
-          total.where = d.where;
+}
+
+/// Bulk particles and shell limit vertices deeper in collider `c` than the limit.
+void IntegrityMonitor::check_collider(const IntegrityView& view, const Collider& c,
+                                      IntegrityReport& r) const {
+  const std::size_t nb = view.bulk ? view.bulk->size() : 0;
+  struct Deep {
+    std::size_t count = 0;
+    double depth = 0;
+    Vec3d where = Vec3d::Zero();
+  };
+  const std::size_t nv = vertex_offset_.back();
+  const std::size_t n = nv + nb;
+  const std::size_t chunks = (n + kGrain - 1) / kGrain;
+  std::vector<Deep> parts(chunks);
+  parallel_for(
+      n, kGrain,
+      [&](std::size_t b, std::size_t e) {
+        Deep& d = parts[b / kGrain];
+        std::size_t s = 0;
+        for (std::size_t i = b; i < e; ++i) {
+          const Vec3d x = point(view, i, s);
+          Aabb at;
+          at.lo = at.hi = x;
+          if (!x.allFinite() || !c.bounds().overlaps(at)) continue;
+          const double depth = -c.phi(x);
+          if (depth > d.depth) {
+            d.depth = depth;
+            d.where = x;
+          }
+          if (depth > r.collider_limit) ++d.count;
         }
-      }
-      r.max_collider_depth = std::max(r.max_collider_depth, total.depth);
-      if (!total.count) continue;
-      IntegrityEvent e;
-      e.kind = IntegrityEvent::Kind::InsideCollider;
-      e.object = c.desc().name;
-      e.count = total.count;
-      e.value = total.depth;
-      e.where = total.where;
-      r.events.push_back(e);
-      r.collider_penetrations += total.count;
+      },
+      view.serial);
+  Deep total;
+  for (const Deep& d : parts) {
+    total.count += d.count;
+    if (d.depth > total.depth) {
+      total.depth = d.depth;
+      total.where = d.where;
     }
-  r.events.insert(r.events.end(), warnings.begin(), warnings.end());
+  }
+  r.max_collider_depth = std::max(r.max_collider_depth, total.depth);
+  if (!total.count) return;
+  IntegrityEvent e;
+  e.kind = IntegrityEvent::Kind::InsideCollider;
+  e.object = c.desc().name;
+  e.count = total.count;
+  e.value = total.depth;
+  e.where = total.where;
+  r.events.push_back(e);
+  r.collider_penetrations += total.count;
 }
 
 }  // namespace shellmpm

@@ -80,6 +80,10 @@ class IntegrityMonitor {
   Vec3d point(const IntegrityView& view, std::size_t i, std::size_t& s) const;
   void compare(const IntegrityView& view, bool record_only);
   void frame_end_checks(const IntegrityView& view, IntegrityReport& r) const;
+  void check_non_finite(const IntegrityView& view, IntegrityReport& r) const;
+  void check_crossings(const IntegrityView& view, IntegrityReport& r) const;
+  void check_stretched(IntegrityReport& r, std::vector<IntegrityEvent>& warnings) const;
+  void check_collider(const IntegrityView& view, const Collider& c, IntegrityReport& r) const;
   const std::vector<Eigen::Vector3i>& tris(std::size_t s) const {
     return shells_[s].limit->triangles();
   }

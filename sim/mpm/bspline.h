@@ -10,10 +10,10 @@ namespace shellmpm {
 
 /// Weights and derivatives (w.r.t. grid coordinate, multiply by 1/dx for world) per axis.
 struct QuadraticWeights {
-  int base[3];      ///< lowest node index per axis
-  Real fx[3];       ///< g - base, in [0.5, 1.5)
-  Real w[3][3];     ///< w[axis][k], k = node offset 0..2
-  Real dw[3][3];    ///< dw/dg
+  int base[3];    ///< lowest node index per axis
+  Real fx[3];     ///< g - base, in [0.5, 1.5)
+  Real w[3][3];   ///< w[axis][k], k = node offset 0..2
+  Real dw[3][3];  ///< dw/dg
 
   /// g: particle position in grid units (position relative to the grid origin / dx).
   explicit QuadraticWeights(const Vec3& g) {

@@ -37,10 +37,10 @@ void ParticleSet::permute(const std::vector<std::uint32_t>& order) {
 }
 
 std::size_t ParticleSet::bytes() const {
-  return x.capacity() * sizeof(Vec3) + v.capacity() * sizeof(Vec3) +
-         C.capacity() * sizeof(Mat3) + F.capacity() * sizeof(Mat3) +
-         volume.capacity() * sizeof(Real) + material.capacity() * sizeof(std::uint16_t) +
-         id.capacity() * sizeof(std::uint32_t) + plastic.capacity() * sizeof(Real);
+  return x.capacity() * sizeof(Vec3) + v.capacity() * sizeof(Vec3) + C.capacity() * sizeof(Mat3) +
+         F.capacity() * sizeof(Mat3) + volume.capacity() * sizeof(Real) +
+         material.capacity() * sizeof(std::uint16_t) + id.capacity() * sizeof(std::uint32_t) +
+         plastic.capacity() * sizeof(Real);
 }
 
 }  // namespace shellmpm

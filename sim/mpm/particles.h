@@ -23,8 +23,7 @@ struct ParticleSet {
   bool keep_plastic = false;  ///< allocate `plastic` (set when any material is plastic)
 
   /// Appends one particle at rest deformation.
-  void push_back(const Vec3& pos, const Vec3& vel, Real vol, std::uint16_t mat,
-                 Real plastic0) {
+  void push_back(const Vec3& pos, const Vec3& vel, Real vol, std::uint16_t mat, Real plastic0) {
     x.push_back(pos);
     v.push_back(vel);
     C.push_back(Mat3::Zero());

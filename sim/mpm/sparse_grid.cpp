@@ -30,9 +30,9 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
     const int bx = static_cast<int>(std::floor(g[0] - Real(0.5))) >> 2;
     const int by = static_cast<int>(std::floor(g[1] - Real(0.5))) >> 2;
     const int bz = static_cast<int>(std::floor(g[2] - Real(0.5))) >> 2;
-    SHELLMPM_CHECK(bx >= 0 && by >= 0 && bz >= 0 && bx < (1 << 19) && by < (1 << 19) &&
-                       bz < (1 << 19),
-                   << "particle " << p << " at " << pos(p).transpose() << " is off the grid");
+    SHELLMPM_CHECK(
+        bx >= 0 && by >= 0 && bz >= 0 && bx < (1 << 19) && by < (1 << 19) && bz < (1 << 19),
+        << "particle " << p << " at " << pos(p).transpose() << " is off the grid");
     const std::uint64_t key = pack_block(bx, by, bz);
     if (key != last_key) {
       last_id = phash_.insert(key);
@@ -49,7 +49,8 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
   order.resize(n);
   {
     std::vector<std::uint32_t> cursor(pblock_start.begin(), pblock_start.end() - 1);
-    for (std::size_t p = 0; p < n; ++p) order[cursor[pblock_of_[p]]++] = static_cast<std::uint32_t>(p);
+    for (std::size_t p = 0; p < n; ++p)
+      order[cursor[pblock_of_[p]]++] = static_cast<std::uint32_t>(p);
   }
   // Grid blocks: every particle block and its +1 neighbours.
   ghash_.clear();

@@ -21,15 +21,19 @@ struct GridNode {
   Real v[3];
 };
 
-constexpr int kBlockSize = 4;                  ///< nodes per block edge
-constexpr int kBlockNodes = 64;                ///< nodes per block
-constexpr int kPadSize = 6;                    ///< padded particle-block buffer edge
-constexpr int kPadNodes = 216;                 ///< nodes in a padded buffer
+constexpr int kBlockSize = 4;    ///< nodes per block edge
+constexpr int kBlockNodes = 64;  ///< nodes per block
+constexpr int kPadSize = 6;      ///< padded particle-block buffer edge
+constexpr int kPadNodes = 216;   ///< nodes in a padded buffer
 
 /// Node index within a 4^3 block (z fastest).
-inline int block_node(int i, int j, int k) { return (i * kBlockSize + j) * kBlockSize + k; }
+inline int block_node(int i, int j, int k) {
+  return (i * kBlockSize + j) * kBlockSize + k;
+}
 /// Node index within a padded 6^3 buffer (z fastest).
-inline int pad_node(int i, int j, int k) { return (i * kPadSize + j) * kPadSize + k; }
+inline int pad_node(int i, int j, int k) {
+  return (i * kPadSize + j) * kPadSize + k;
+}
 
 class SparseGrid {
  public:
@@ -60,9 +64,9 @@ class SparseGrid {
   std::size_t bytes() const;
 
   // Particle blocks (binned particles).
-  std::vector<std::uint32_t> order;          ///< particle indices sorted by particle block
-  std::vector<std::uint32_t> pblock_start;   ///< order[pblock_start[b] .. pblock_start[b+1])
-  std::vector<std::uint64_t> pblock_key;     ///< packed block coordinate
+  std::vector<std::uint32_t> order;            ///< particle indices sorted by particle block
+  std::vector<std::uint32_t> pblock_start;     ///< order[pblock_start[b] .. pblock_start[b+1])
+  std::vector<std::uint64_t> pblock_key;       ///< packed block coordinate
   std::vector<std::array<int, 8>> pblock_nbr;  ///< grid block at key + (ox,oy,oz), o = 4ox+2oy+oz
   std::vector<std::array<GridNode, kPadNodes>> pblock_buf;  ///< scatter/gather buffers
   // Grid blocks.

@@ -4,7 +4,7 @@
 #include <cstring>
 
 #include "sim/core/parallel.h"
-#include "sim/mpm/bspline.h"
+#include "sim/mpm/apic_stencil.h"
 
 namespace shellmpm {
 namespace {
@@ -50,11 +50,6 @@ void block_stresses(const ParticleSet& p, const SparseGrid& grid, const Transfer
   }
 }
 
-// The node loops below factor the tensor-product sums: with d = node - fx (grid units),
-// A d = (A (-fx)) + A.col(0) i + A.col(1) j + A.col(2) k, and the kernel gradient
-// (dwx wy wz, wx dwy wz, wx wy dwz) splits into per-axis factors, so the innermost loop
-// does a few vector FMAs per node.
-
 template <bool kMls>
 void p2g_block(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp, std::size_t b) {
   thread_local std::vector<Mat3> F_local, tau_local;
@@ -81,31 +76,7 @@ void p2g_block(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp,
     else
       S = (dt * vol / dx) * tau;  // APIC: -dt V0 tau grad w, grad w = dw_grid / dx
     const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-    const Vec3 base = m * p.v[q] - A * fx;
-    const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-    for (int i = 0; i < 3; ++i) {
-      const Vec3 bi = base + Real(i) * A.col(0);
-      const Vec3 s0i = W.dw[0][i] * S.col(0), s12i = W.w[0][i] * S.col(1),
-                 s2i = W.w[0][i] * S.col(2);
-      for (int j = 0; j < 3; ++j) {
-        const Vec3 bij = bi + Real(j) * A.col(1);
-        const Real wxy = W.w[0][i] * W.w[1][j];
-        // Force factors: S gw = (s0i wy + s12i dwy) wz + (s2i wy) dwz.
-        const Vec3 fz = W.w[1][j] * s0i + W.dw[1][j] * s12i;
-        const Vec3 fdz = W.w[1][j] * s2i;
-        GridNode* row = &buf[pad_node(lx + i, ly + j, lz)];
-        for (int k = 0; k < 3; ++k) {
-          const Real w = wxy * W.w[2][k];
-          Vec3 mom = w * (bij + Real(k) * A.col(2));
-          if (!kMls) mom -= W.w[2][k] * fz + W.dw[2][k] * fdz;
-          GridNode& nd = row[k];
-          nd.m += w * m;
-          nd.v[0] += mom[0];
-          nd.v[1] += mom[1];
-          nd.v[2] += mom[2];
-        }
-      }
-    }
+    apic_scatter<!kMls>(buf.data(), W, bc, m, m * p.v[q] - A * fx, A, S);
   }
 }
 
@@ -119,55 +90,11 @@ void g2p_block(ParticleSet& p, SparseGrid& grid, const TransferParams& tp, std::
   for (std::uint32_t s = bulk_begin(grid, tp, b); s < grid.pblock_start[b + 1]; ++s) {
     const std::uint32_t q = grid.order[s] - tp.first_bulk;
     const QuadraticWeights W(grid.grid_coord(p.x[q]));
-    const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-    // Sums over nodes of w v, w v i, w v j, w v k and the gradient sums, built per axis.
-    Vec3 v = Vec3::Zero(), vi_sum = Vec3::Zero(), vj_sum = Vec3::Zero(), vk_sum = Vec3::Zero();
-    Vec3 gx = Vec3::Zero(), gy = Vec3::Zero(), gz = Vec3::Zero();
-    for (int i = 0; i < 3; ++i) {
-      Vec3 P = Vec3::Zero(), Pj = Vec3::Zero(), Pk = Vec3::Zero(), Gy = Vec3::Zero(),
-           Gz = Vec3::Zero();
-      for (int j = 0; j < 3; ++j) {
-        const GridNode* row = &buf[pad_node(lx + i, ly + j, lz)];
-        Vec3 Q = Vec3::Zero(), Qk = Vec3::Zero(), Qdz = Vec3::Zero();
-        for (int k = 0; k < 3; ++k) {
-          const Vec3 vn(row[k].v[0], row[k].v[1], row[k].v[2]);
-          const Vec3 wv = W.w[2][k] * vn;
-          Q += wv;
-          Qk += Real(k) * wv;
-          if (!kMls) Qdz += W.dw[2][k] * vn;
-        }
-        P += W.w[1][j] * Q;
-        Pj += (W.w[1][j] * Real(j)) * Q;
-        Pk += W.w[1][j] * Qk;
-        if (!kMls) {
-          Gy += W.dw[1][j] * Q;
-          Gz += W.w[1][j] * Qdz;
-        }
-      }
-      v += W.w[0][i] * P;
-      vi_sum += (W.w[0][i] * Real(i)) * P;
-      vj_sum += W.w[0][i] * Pj;
-      vk_sum += W.w[0][i] * Pk;
-      if (!kMls) {
-        gx += W.dw[0][i] * P;
-        gy += W.w[0][i] * Gy;
-        gz += W.w[0][i] * Gz;
-      }
-    }
-    // B = sum w v (node - fx)^T in grid units; C = B D^-1 with D = dx^2/4 I, B_world = dx B.
-    Mat3 B;
-    B.col(0) = vi_sum - W.fx[0] * v;
-    B.col(1) = vj_sum - W.fx[1] * v;
-    B.col(2) = vk_sum - W.fx[2] * v;
-    const Mat3 C = (Real(4) * inv_dx) * B;
-    Mat3 gradv;
-    if (kMls) {
-      gradv = C;
-    } else {
-      gradv.col(0) = inv_dx * gx;
-      gradv.col(1) = inv_dx * gy;
-      gradv.col(2) = inv_dx * gz;
-    }
+    const ApicGather G = apic_gather<!kMls>(buf.data(), W, bc);
+    // C = B D^-1 with D = dx^2/4 I, B_world = dx B.
+    const Mat3 C = (Real(4) * inv_dx) * G.B;
+    const Mat3 gradv = kMls ? C : Mat3(inv_dx * G.grad);
+    const Vec3& v = G.v;
     p.v[q] = v;
     p.C[q] = C;
     p.x[q] += dt * v;

@@ -13,10 +13,10 @@
 namespace shellmpm {
 
 struct TransferParams {
-  Real dt = 0;                                  ///< step [s]
-  bool mls = false;                             ///< MLS-MPM instead of APIC
-  bool serial = false;                          ///< run without threads
-  bool stress = true;                           ///< add internal forces in P2G
+  Real dt = 0;                                             ///< step [s]
+  bool mls = false;                                        ///< MLS-MPM instead of APIC
+  bool serial = false;                                     ///< run without threads
+  bool stress = true;                                      ///< add internal forces in P2G
   const std::vector<ConstitutiveModel>* models = nullptr;  ///< per material
   const std::vector<Real>* densities = nullptr;            ///< rest density per material
   /// Binned indices below this are other points (shell control points, contact

@@ -1,6 +1,7 @@
 // The in-memory description of a shot: pure data, filled by io/scene_reader from a
 // scene file (and by tests directly). Units are SI, Y up, unless `units` says otherwise.
 #pragma once
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -12,23 +13,27 @@
 
 namespace shellmpm {
 
+/// The particle-grid transfer: quadratic B-spline APIC, or MLS-MPM (Hu et al. 2018).
+enum class Transfer { Apic, Mls };
+/// Whether shells that share grid nodes share one velocity there (no-slip between them, as
+/// in the paper) or each keeps its own (ShellFields; friction from contact only).
+enum class ShellVelocities { PerShell, Shared };
+
 /// Shot-wide settings.
 struct ShotSettings {
-  int frame_start = 1;            ///< first frame written; frame f is the state at t = (f-1)/fps
-  int frame_end = 48;             ///< last frame written, inclusive
-  double fps = 24.0;              ///< frames per second
-  double cfl = 0.3;               ///< CFL number: max particle travel per step, in cells
-  double dt_min = 1e-6;           ///< smallest allowed step [s]; a smaller need is an error
-  double dt_max = 1e-2;           ///< largest allowed step [s]
+  int frame_start = 1;             ///< first frame written; frame f is the state at t = (f-1)/fps
+  int frame_end = 48;              ///< last frame written, inclusive
+  double fps = 24.0;               ///< frames per second
+  double cfl = 0.3;                ///< CFL number: max particle travel per step, in cells
+  double dt_min = 1e-6;            ///< smallest allowed step [s]; a smaller need is an error
+  double dt_max = 1e-2;            ///< largest allowed step [s]
   Vec3d gravity{0.0, -9.81, 0.0};  ///< [m/s^2]
-  Vec3d domain_min{-1, -1, -1};   ///< simulation domain; particles are kept inside [m]
+  Vec3d domain_min{-1, -1, -1};    ///< simulation domain; particles are kept inside [m]
   Vec3d domain_max{1, 1, 1};
-  double dx = 0.02;               ///< grid spacing [m]
-  int threads = 0;                ///< 0 = all cores
-  std::string transfer = "apic";  ///< "apic" (quadratic B-spline APIC) or "mls" (MLS-MPM)
-  /// True: shells that share grid nodes share one velocity there (no-slip between them,
-  /// as in the paper); false: each keeps its own (ShellFields), friction from contact only.
-  bool shared_shell_velocity = false;
+  double dx = 0.02;  ///< grid spacing [m]
+  int threads = 0;   ///< 0 = all cores
+  Transfer transfer = Transfer::Apic;
+  ShellVelocities shell_velocities = ShellVelocities::PerShell;
   /// True: where two layers of one shell meet at a node they get two velocities there
   /// (sim/contact/shell_folds.cpp), so a fold slides over its own cloth at Coulomb's law;
   /// false: one (the fold drags; cheaper for a lone shell).
@@ -36,8 +41,8 @@ struct ShotSettings {
   /// The shell guard (sim/contact/shell_guard.h): stops contact shells from closing
   /// closer than shell_guard_gap where the grid cannot hold them apart.
   bool shell_guard = true;
-  double shell_guard_gap = 0;     ///< [m]; 0: the larger of 0.05 dx and the thickest contact shell
-  std::string units = "m";        ///< informational, written to VDB metadata
+  double shell_guard_gap = 0;  ///< [m]; 0: the larger of 0.05 dx and the thickest contact shell
+  std::string units = "m";     ///< informational, written to VDB metadata
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
   enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;
@@ -51,9 +56,9 @@ struct MaterialDesc {
   std::string name;
   MaterialKind kind = MaterialKind::Elastic;
   ElasticModel model = ElasticModel::FixedCorotated;  ///< elastic only
-  double youngs_modulus = 1e5;  ///< E [Pa]
-  double poisson_ratio = 0.3;   ///< nu, in [0, 0.5)
-  double density = 1000.0;      ///< rest density [kg/m^3]
+  double youngs_modulus = 1e5;                        ///< E [Pa]
+  double poisson_ratio = 0.3;                         ///< nu, in [0, 0.5)
+  double density = 1000.0;                            ///< rest density [kg/m^3]
   // sand (Drucker-Prager on Hencky strain, Klar et al. 2016)
   double friction_angle_deg = 30.0;  ///< internal friction angle [degrees]
   double cohesion = 0.0;             ///< cohesion, as a Hencky-strain offset (>= 0)
@@ -82,8 +87,8 @@ struct ShapeDesc {
   std::string mesh_where;
   /// where the shape was given ("file:line: key"), for messages; may be empty
   std::string where;
-  double mesh_scale = 1.0;           ///< mesh: uniform scale applied on load
-  Vec3d mesh_translate{0, 0, 0};     ///< mesh: translation applied on load
+  double mesh_scale = 1.0;        ///< mesh: uniform scale applied on load
+  Vec3d mesh_translate{0, 0, 0};  ///< mesh: translation applied on load
   /// mesh: signed distance (negative inside), built by io/ from the mesh file.
   std::shared_ptr<const SdfGrid> sdf;
 };
@@ -91,21 +96,21 @@ struct ShapeDesc {
 /// A particle source.
 struct SourceDesc {
   std::string name;
-  int material = 0;           ///< index into Scene::materials
+  int material = 0;  ///< index into Scene::materials
   ShapeDesc shape;
   double particles_per_cell = 8;
-  Vec3d velocity{0, 0, 0};    ///< initial velocity [m/s]
-  unsigned seed = 1;          ///< jitter seed (sampling is deterministic)
-  bool emit = false;          ///< continuous emission instead of one fill at the start
-  int emit_start = 1;         ///< first frame of emission (inclusive)
-  int emit_end = 1;           ///< last frame of emission (inclusive)
+  Vec3d velocity{0, 0, 0};  ///< initial velocity [m/s]
+  unsigned seed = 1;        ///< jitter seed (sampling is deterministic)
+  bool emit = false;        ///< continuous emission instead of one fill at the start
+  int emit_start = 1;       ///< first frame of emission (inclusive)
+  int emit_end = 1;         ///< last frame of emission (inclusive)
 };
 
 /// One keyframe of a collider's rigid motion (applied about the origin: x' = R s x + T).
 struct Keyframe {
-  double time = 0.0;                   ///< [s]
-  Vec3d translate{0, 0, 0};            ///< [m]
-  Vec3d rotate_deg{0, 0, 0};           ///< XYZ Euler angles [degrees], R = Rz Ry Rx
+  double time = 0.0;          ///< [s]
+  Vec3d translate{0, 0, 0};   ///< [m]
+  Vec3d rotate_deg{0, 0, 0};  ///< XYZ Euler angles [degrees], R = Rz Ry Rx
 };
 
 enum class BoundaryKind { Sticky, Slip, Separate };
@@ -115,8 +120,8 @@ struct ColliderDesc {
   std::string name;
   ShapeDesc shape;
   BoundaryKind boundary = BoundaryKind::Separate;
-  double friction = 0.0;               ///< Coulomb coefficient (slip, separate)
-  std::vector<Keyframe> keyframes;     ///< empty = static; linear/slerp between keys
+  double friction = 0.0;            ///< Coulomb coefficient (slip, separate)
+  std::vector<Keyframe> keyframes;  ///< empty = static; linear/slerp between keys
 };
 
 /// A Kirchhoff-Love shell material (plane-stress Hencky laminate, METHOD.md).
@@ -130,17 +135,17 @@ struct ShellMaterialDesc {
   /// Principal stretch s_l beyond which the membrane stiffens (kirchhoff_love.h), in
   /// (1, KirchhoffLoveShellT::kMaxStretchLimit]; below it the energy is plain Hencky.
   double stretch_limit = 1.5;
-  double damping = 0.0;         ///< mass-proportional damping rate [1/s]
+  double damping = 0.0;            ///< mass-proportional damping rate [1/s]
   double stiffness_damping = 0.0;  ///< Rayleigh stiffness-proportional damping [s]
-  int quadrature_inplane = 3;   ///< in-plane points per triangle: 1, 3, 6 or 7
-  int quadrature_thickness = 3; ///< Gauss points through the thickness: 1 to 5
+  int quadrature_inplane = 3;      ///< in-plane points per triangle: 1, 3, 6 or 7
+  int quadrature_thickness = 3;    ///< Gauss points through the thickness: 1 to 5
   // Contact (issue 4; used when the shell's control points are on the MPM grid).
-  double friction = 0.3;           ///< Coulomb coefficient c_F between shells
-  double contact_stiffness = 0;    ///< k_c [Pa]; 0 = youngs_modulus
-  double contact_shear = 0;        ///< gamma [Pa]; 0 = contact stiffness
-  int contact_samples = 1;         ///< contact particles per triangle: 1, 3, 6 or 7
-  std::optional<Vec3d> front_color;  ///< preview colour of the +normal side; none: render's
-  std::optional<Vec3d> back_color;   ///< preview colour of the other side; none: render's
+  double friction = 0.3;                    ///< Coulomb coefficient c_F between shells
+  std::optional<double> contact_stiffness;  ///< k_c [Pa]; none: youngs_modulus
+  std::optional<double> contact_shear;      ///< gamma [Pa]; none: the contact stiffness
+  int contact_samples = 1;                  ///< contact particles per triangle: 1, 3, 6 or 7
+  std::optional<Vec3d> front_color;         ///< preview colour of the +normal side; none: render's
+  std::optional<Vec3d> back_color;          ///< preview colour of the other side; none: render's
 };
 
 /// A rigid keyframed motion shared by pins (and colliders).
@@ -148,13 +153,13 @@ using Motion = std::vector<Keyframe>;
 
 /// Pinned control points of a shell: chosen by index, by region or by named group.
 struct PinDesc {
-  std::vector<int> indices;              ///< control point indices
-  bool has_box = false;                  ///< select points inside [box_min, box_max] (rest pose)
+  std::vector<int> indices;  ///< control point indices
+  bool has_box = false;      ///< select points inside [box_min, box_max] (rest pose)
   Vec3d box_min{0, 0, 0}, box_max{0, 0, 0};
-  std::string group;                     ///< a named vertex group of the mesh file
-  bool components[3] = {true, true, true};  ///< which of x, y, z are held
-  Motion keyframes;                      ///< empty: fixed at the rest position; else moves rigidly
-  double release_time = -1;              ///< the pin lets go after this time [s]; < 0: never
+  std::string group;                                 ///< a named vertex group of the mesh file
+  std::array<bool, 3> components{true, true, true};  ///< which of x, y, z are held
+  Motion keyframes;                    ///< empty: fixed at the rest position; else moves rigidly
+  std::optional<double> release_time;  ///< the pin lets go after this time [s]; none: never
   /// where the selector was given, for messages, as "file:line: key" (UserError's prefix),
   /// e.g. "shot.yaml:30: shells[0].pins[1].indices" (or .box / .group); may be empty
   std::string where;
@@ -176,11 +181,11 @@ struct ShellDesc {
   enum class Kind { Mesh, Sheet, Cylinder, Sphere } kind = Kind::Sheet;
   // mesh
   std::string mesh_path;
-  std::string mesh_where;  ///< "file:line: key" for messages
+  std::string mesh_where;                 ///< "file:line: key" for messages
   std::shared_ptr<const ShellMesh> mesh;  ///< filled by io/ (load_scene_assets) for Kind::Mesh
   // sheet: a rectangle in the local XZ plane (normal +Y), size along X and Z
-  double size[2] = {1.0, 1.0};
-  int resolution[2] = {10, 10};  ///< quads along X and Z (two triangles each)
+  std::array<double, 2> size{1.0, 1.0};
+  std::array<int, 2> resolution{10, 10};  ///< quads along X and Z (two triangles each)
   // cylinder patch: axis along local Y, angle in degrees around it (360 = closed tube)
   double radius = 0.5;
   double height = 1.0;
@@ -196,9 +201,9 @@ struct ShellDesc {
   std::string placement_where;
   Vec3d velocity{0, 0, 0};  ///< initial velocity [m/s]
   std::vector<PinDesc> pins;
-  double pressure = 0.0;    ///< surface load along the normal [Pa] (positive pushes along +normal)
+  double pressure = 0.0;  ///< surface load along the normal [Pa] (positive pushes along +normal)
   std::vector<PointLoadDesc> point_loads;
-  int output_refine = 0;    ///< limit-surface refinement levels of the written mesh (0..4)
+  int output_refine = 0;  ///< limit-surface refinement levels of the written mesh (0..4)
   /// Frictional contact on the MPM grid: Auto = on when the scene has a collider, bulk
   /// material or another shell; On also gives self-contact of a lone shell.
   enum class Contact { Auto, On, Off } contact = Contact::Auto;
@@ -214,6 +219,9 @@ struct PrerollSettings {
   double tolerance = 1e-4;  ///< stop when max |residual force| / max |gravity force| < tolerance
   int max_steps = 200000;   ///< give up (error) after this many steps (static: iterations)
 };
+
+/// The file format of the shell meshes written per frame.
+enum class MeshFormat { Ply, Obj, Glb };
 
 /// What to write.
 struct OutputSettings {
@@ -231,7 +239,7 @@ struct OutputSettings {
   /// Per shell; {name} = the shell's name. The reader defaults the extension to
   /// shell_format (".glb" for glb) and refuses a pattern that names another format.
   std::string shell_pattern = "{name}.####.ply";
-  std::string shell_format = "ply";  ///< ply (binary) | obj | glb
+  MeshFormat shell_format = MeshFormat::Ply;  ///< ply (binary) | obj | glb
 };
 
 /// A preview camera (render.cameras[]): looks from `position` at `target`.
@@ -243,29 +251,34 @@ struct RenderCamera {
   double fov_deg = 40.0;    ///< vertical field of view [degrees]
 };
 
+/// How previews are drawn: OpenGL rasterisation (OSMesa) or ray tracing (Embree).
+enum class RendererKind { Raster, Raytrace };
+/// How a preview draws the bulk material: Auto picks from the renderer and the outputs.
+enum class BulkDraw { Auto, Volume, Surface, Particles, None };
+
 /// Preview rendering (render/, `shellmpm render`, `run --preview`). Colours are linear RGB
 /// in [0, 1]. Nothing here changes the simulation.
 struct RenderSettings {
-  bool preview = false;                    ///< render each frame while `run` writes it
-  std::string renderer = "raster";         ///< raster (OSMesa) | raytrace (Embree)
-  int width = 960, height = 540;           ///< image size [pixels]
-  std::string camera;                      ///< name in `cameras` or "auto"; empty: first, else auto
+  bool preview = false;  ///< render each frame while `run` writes it
+  RendererKind renderer = RendererKind::Raster;
+  int width = 960, height = 540;  ///< image size [pixels]
+  std::string camera;             ///< name in `cameras` or "auto"; empty: first, else auto
   std::vector<RenderCamera> cameras;
-  int samples = 4;                         ///< ray traced: samples per pixel
-  int ao_samples = 2;                      ///< ray traced: ambient-occlusion rays per sample
-  std::string bulk = "auto";               ///< auto | volume | surface | particles | none
-  double volume_extinction = 250.0;        ///< extinction of density 1 [1/m]
-  double iso_value = 0.5;                  ///< density of the bulk surface
-  double particle_radius = 0.0;            ///< [m]; 0 = half the particle spacing
-  bool ground = true;                      ///< draw a ground plane
-  std::optional<Vec3d> key_light;          ///< direction towards the key light; none: camera rig
-  Vec3d shell_front{0.80, 0.30, 0.20};     ///< default shell front (+normal side) colour
-  Vec3d shell_back{0.20, 0.42, 0.80};      ///< default shell back colour
+  int samples = 4;     ///< ray traced: samples per pixel
+  int ao_samples = 2;  ///< ray traced: ambient-occlusion rays per sample
+  BulkDraw bulk = BulkDraw::Auto;
+  double volume_extinction = 250.0;       ///< extinction of density 1 [1/m]
+  double iso_value = 0.5;                 ///< density of the bulk surface
+  std::optional<double> particle_radius;  ///< [m]; none: half the particle spacing
+  bool ground = true;                     ///< draw a ground plane
+  std::optional<Vec3d> key_light;         ///< direction towards the key light; none: camera rig
+  Vec3d shell_front{0.80, 0.30, 0.20};    ///< default shell front (+normal side) colour
+  Vec3d shell_back{0.20, 0.42, 0.80};     ///< default shell back colour
   Vec3d collider_color{0.45, 0.45, 0.48};
   Vec3d ground_color{0.5, 0.5, 0.48};
   std::string pattern = "preview.####.png";
-  bool contact_sheet = true;               ///< contact_sheet.png per run
-  bool movie = true;                       ///< preview.mp4 when ffmpeg is installed
+  bool contact_sheet = true;  ///< contact_sheet.png per run
+  bool movie = true;          ///< preview.mp4 when ffmpeg is installed
 };
 
 /// A whole shot.

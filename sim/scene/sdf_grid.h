@@ -8,10 +8,10 @@
 namespace shellmpm {
 
 struct SdfGrid {
-  Vec3d origin{0, 0, 0};   ///< world position of sample (0,0,0) [m]
-  double spacing = 1.0;    ///< sample spacing [m]
-  Vec3i dims{0, 0, 0};     ///< samples per axis
-  float background = 1e3f; ///< value returned outside the sampled box (positive: outside)
+  Vec3d origin{0, 0, 0};      ///< world position of sample (0,0,0) [m]
+  double spacing = 1.0;       ///< sample spacing [m]
+  Vec3i dims{0, 0, 0};        ///< samples per axis
+  float background = 1e3f;    ///< value returned outside the sampled box (positive: outside)
   std::vector<float> values;  ///< x fastest: values[(k*dims.y + j)*dims.x + i]
 
   /// Trilinear sample; positions outside the box return max(background, distance to box).

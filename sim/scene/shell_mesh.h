@@ -9,10 +9,10 @@
 namespace shellmpm {
 
 struct ShellMesh {
-  std::vector<Vec3d> vertices;                    ///< control points, rest pose [m]
-  std::vector<Eigen::Vector3i> triangles;         ///< counter-clockwise seen from +normal
-  std::vector<Eigen::Vector2d> uvs;               ///< per vertex; empty when the input has none
-  std::map<std::string, std::vector<int>> groups; ///< named vertex groups (sorted indices)
+  std::vector<Vec3d> vertices;                     ///< control points, rest pose [m]
+  std::vector<Eigen::Vector3i> triangles;          ///< counter-clockwise seen from +normal
+  std::vector<Eigen::Vector2d> uvs;                ///< per vertex; empty when the input has none
+  std::map<std::string, std::vector<int>> groups;  ///< named vertex groups (sorted indices)
 };
 
 }  // namespace shellmpm

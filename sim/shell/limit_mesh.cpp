@@ -59,8 +59,9 @@ LimitMesh::LimitMesh(const LoopBasis& basis, const std::vector<Eigen::Vector3i>&
           rows_.push_back(std::move(r));
           if (!uvs.empty()) {
             const Eigen::Vector3i& t = triangles[f];
-            uvs_.push_back((double(n - i - j) * uvs[t[0]] + double(i) * uvs[t[1]] +
-                            double(j) * uvs[t[2]]) / n);
+            uvs_.push_back(
+                (double(n - i - j) * uvs[t[0]] + double(i) * uvs[t[1]] + double(j) * uvs[t[2]]) /
+                n);
           }
         } else {
           id = it->second;

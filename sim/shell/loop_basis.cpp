@@ -40,29 +40,86 @@ const BoxFunction kBox[12] = {
     {2, {{4, 0, 0, 1}, {3, 1, 0, 2}}},
     {2, {{4, 0, 0, 1}, {3, 0, 1, 2}}},
     {9,
-     {{4, 0, 0, 1}, {3, 0, 1, 2}, {3, 1, 0, 6}, {2, 1, 1, 6}, {2, 2, 0, 12}, {1, 2, 1, 6},
-      {1, 3, 0, 6}, {0, 3, 1, 2}, {0, 4, 0, 1}}},
+     {{4, 0, 0, 1},
+      {3, 0, 1, 2},
+      {3, 1, 0, 6},
+      {2, 1, 1, 6},
+      {2, 2, 0, 12},
+      {1, 2, 1, 6},
+      {1, 3, 0, 6},
+      {0, 3, 1, 2},
+      {0, 4, 0, 1}}},
     {15,
-     {{4, 0, 0, 6}, {3, 0, 1, 24}, {2, 0, 2, 24}, {1, 0, 3, 8}, {0, 0, 4, 1}, {3, 1, 0, 24},
-      {2, 1, 1, 60}, {1, 1, 2, 36}, {0, 1, 3, 6}, {2, 2, 0, 24}, {1, 2, 1, 36}, {0, 2, 2, 12},
-      {1, 3, 0, 8}, {0, 3, 1, 6}, {0, 4, 0, 1}}},
+     {{4, 0, 0, 6},
+      {3, 0, 1, 24},
+      {2, 0, 2, 24},
+      {1, 0, 3, 8},
+      {0, 0, 4, 1},
+      {3, 1, 0, 24},
+      {2, 1, 1, 60},
+      {1, 1, 2, 36},
+      {0, 1, 3, 6},
+      {2, 2, 0, 24},
+      {1, 2, 1, 36},
+      {0, 2, 2, 12},
+      {1, 3, 0, 8},
+      {0, 3, 1, 6},
+      {0, 4, 0, 1}}},
     {9,
-     {{4, 0, 0, 1}, {3, 0, 1, 6}, {2, 0, 2, 12}, {1, 0, 3, 6}, {0, 0, 4, 1}, {3, 1, 0, 2},
-      {2, 1, 1, 6}, {1, 1, 2, 6}, {0, 1, 3, 2}}},
+     {{4, 0, 0, 1},
+      {3, 0, 1, 6},
+      {2, 0, 2, 12},
+      {1, 0, 3, 6},
+      {0, 0, 4, 1},
+      {3, 1, 0, 2},
+      {2, 1, 1, 6},
+      {1, 1, 2, 6},
+      {0, 1, 3, 2}}},
     {2, {{1, 3, 0, 2}, {0, 4, 0, 1}}},
     {15,
-     {{4, 0, 0, 1}, {3, 0, 1, 6}, {2, 0, 2, 12}, {1, 0, 3, 6}, {0, 0, 4, 1}, {3, 1, 0, 8},
-      {2, 1, 1, 36}, {1, 1, 2, 36}, {0, 1, 3, 8}, {2, 2, 0, 24}, {1, 2, 1, 60}, {0, 2, 2, 24},
-      {1, 3, 0, 24}, {0, 3, 1, 24}, {0, 4, 0, 6}}},
+     {{4, 0, 0, 1},
+      {3, 0, 1, 6},
+      {2, 0, 2, 12},
+      {1, 0, 3, 6},
+      {0, 0, 4, 1},
+      {3, 1, 0, 8},
+      {2, 1, 1, 36},
+      {1, 1, 2, 36},
+      {0, 1, 3, 8},
+      {2, 2, 0, 24},
+      {1, 2, 1, 60},
+      {0, 2, 2, 24},
+      {1, 3, 0, 24},
+      {0, 3, 1, 24},
+      {0, 4, 0, 6}}},
     {15,
-     {{4, 0, 0, 1}, {3, 0, 1, 8}, {2, 0, 2, 24}, {1, 0, 3, 24}, {0, 0, 4, 6}, {3, 1, 0, 6},
-      {2, 1, 1, 36}, {1, 1, 2, 60}, {0, 1, 3, 24}, {2, 2, 0, 12}, {1, 2, 1, 36}, {0, 2, 2, 24},
-      {1, 3, 0, 6}, {0, 3, 1, 8}, {0, 4, 0, 1}}},
+     {{4, 0, 0, 1},
+      {3, 0, 1, 8},
+      {2, 0, 2, 24},
+      {1, 0, 3, 24},
+      {0, 0, 4, 6},
+      {3, 1, 0, 6},
+      {2, 1, 1, 36},
+      {1, 1, 2, 60},
+      {0, 1, 3, 24},
+      {2, 2, 0, 12},
+      {1, 2, 1, 36},
+      {0, 2, 2, 24},
+      {1, 3, 0, 6},
+      {0, 3, 1, 8},
+      {0, 4, 0, 1}}},
     {2, {{1, 0, 3, 2}, {0, 0, 4, 1}}},
     {2, {{0, 3, 1, 2}, {0, 4, 0, 1}}},
     {9,
-     {{1, 0, 3, 2}, {0, 0, 4, 1}, {1, 1, 2, 6}, {0, 1, 3, 6}, {1, 2, 1, 6}, {0, 2, 2, 12},
-      {1, 3, 0, 2}, {0, 3, 1, 6}, {0, 4, 0, 1}}},
+     {{1, 0, 3, 2},
+      {0, 0, 4, 1},
+      {1, 1, 2, 6},
+      {0, 1, 3, 6},
+      {1, 2, 1, 6},
+      {0, 2, 2, 12},
+      {1, 3, 0, 2},
+      {0, 3, 1, 6},
+      {0, 4, 0, 1}}},
     {2, {{0, 0, 4, 1}, {0, 1, 3, 2}}},
 };
 
@@ -467,8 +524,8 @@ LoopBasis::LoopBasis(int num_vertices, const std::vector<Eigen::Vector3i>& trian
         std::string faces;
         for (int i = face_offset_[v]; i < face_offset_[v + 1] && i < face_offset_[v] + 8; ++i)
           faces += (faces.empty() ? "" : ", ") + std::to_string(raw[i]);
-        throw std::invalid_argument("LoopBasis: vertex " + std::to_string(v) + " (faces " +
-                                    faces + "): " + err);
+        throw std::invalid_argument("LoopBasis: vertex " + std::to_string(v) + " (faces " + faces +
+                                    "): " + err);
       }
       for (std::size_t i = 0; i < order.size(); ++i)
         vface_[face_offset_[v] + i] = raw[face_offset_[v] + order[i]];
@@ -562,8 +619,7 @@ int LoopBasis::evaluate_impl(int face, double xi1, double xi2, BasisPoint* out) 
     for (int i = face_offset_[c[k]]; i < face_offset_[c[k] + 1]; ++i) {
       const int f = vface_[i];
       bool seen = false;
-      std::array<int, 3> lf = {local_of(tris_[f][0]), local_of(tris_[f][1]),
-                               local_of(tris_[f][2])};
+      std::array<int, 3> lf = {local_of(tris_[f][0]), local_of(tris_[f][1]), local_of(tris_[f][2])};
       for (const auto& g : m.faces) seen |= g == lf;
       if (seen) continue;
       if (f == face) m.target = static_cast<int>(m.faces.size());
@@ -578,8 +634,8 @@ int LoopBasis::evaluate_impl(int face, double xi1, double xi2, BasisPoint* out) 
   Scratch w;
   target_fans(m, w);
   for (int level = 1;; ++level) {
-    SHELLMPM_CHECK(level <= 80, << "local subdivision did not reach a regular patch (face "
-                                << face << ", xi " << xi1 << ", " << xi2 << ")");
+    SHELLMPM_CHECK(level <= 80, << "local subdivision did not reach a regular patch (face " << face
+                                << ", xi " << xi1 << ", " << xi2 << ")");
     subdivide_local(m, w, s, t, scale);
     target_fans(m, w);
     const std::array<int, 3>& lt = m.faces[m.target];
@@ -607,7 +663,8 @@ int LoopBasis::evaluate_impl(int face, double xi1, double xi2, BasisPoint* out) 
       std::vector<int> lim_ctrl;
       std::vector<double> lim_w;
       vertex_limit_weights(c[exact_corner], lim_ctrl, lim_w);
-      for (std::size_t k = 0; k < lim_ctrl.size(); ++k) global(local_of(lim_ctrl[k]), 0) += lim_w[k];
+      for (std::size_t k = 0; k < lim_ctrl.size(); ++k)
+        global(local_of(lim_ctrl[k]), 0) += lim_w[k];
     }
     BasisPoint& o = *out;
     o.ctrl = ctrl;

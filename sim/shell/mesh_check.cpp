@@ -11,13 +11,20 @@ namespace shellmpm {
 
 const char* to_string(MeshProblemKind kind) {
   switch (kind) {
-    case MeshProblemKind::NonManifoldEdge: return "non-manifold edge";
-    case MeshProblemKind::NonManifoldVertex: return "non-manifold vertex";
-    case MeshProblemKind::DuplicateVertex: return "duplicate vertex";
-    case MeshProblemKind::ZeroAreaFace: return "zero-area face";
-    case MeshProblemKind::InconsistentOrientation: return "inconsistent orientation";
-    case MeshProblemKind::DegenerateIndex: return "degenerate index";
-    case MeshProblemKind::IsolatedVertex: return "isolated vertex";
+    case MeshProblemKind::NonManifoldEdge:
+      return "non-manifold edge";
+    case MeshProblemKind::NonManifoldVertex:
+      return "non-manifold vertex";
+    case MeshProblemKind::DuplicateVertex:
+      return "duplicate vertex";
+    case MeshProblemKind::ZeroAreaFace:
+      return "zero-area face";
+    case MeshProblemKind::InconsistentOrientation:
+      return "inconsistent orientation";
+    case MeshProblemKind::DegenerateIndex:
+      return "degenerate index";
+    case MeshProblemKind::IsolatedVertex:
+      return "isolated vertex";
   }
   return "unknown";
 }
@@ -80,8 +87,8 @@ std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
         std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
     const double twice_area = (b - a).cross(c - a).norm();
     if (longest == 0 || twice_area <= 1e-12 * longest)
-      zero_area.push_back(make(MeshProblemKind::ZeroAreaFace, {f},
-                               {t[0], t[1], t[2]}, "its corners are collinear or coincide"));
+      zero_area.push_back(make(MeshProblemKind::ZeroAreaFace, {f}, {t[0], t[1], t[2]},
+                               "its corners are collinear or coincide"));
   }
 
   // Edges: undirected key -> faces using it, with direction.
@@ -128,20 +135,23 @@ std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
           parent[find_root(parent, static_cast<int>(i))] = find_root(parent, it->second);
       }
     int fans = 0;
-    for (std::size_t i = 0; i < fs.size(); ++i) fans += find_root(parent, static_cast<int>(i)) == static_cast<int>(i);
+    for (std::size_t i = 0; i < fs.size(); ++i)
+      fans += find_root(parent, static_cast<int>(i)) == static_cast<int>(i);
     if (fans > 1)
-      nonmanifold_vertex.push_back(make(MeshProblemKind::NonManifoldVertex, fs, {v},
-                                        std::to_string(fans) + " separate fans of faces meet there"));
+      nonmanifold_vertex.push_back(
+          make(MeshProblemKind::NonManifoldVertex, fs, {v},
+               std::to_string(fans) + " separate fans of faces meet there"));
   }
 
   // Exactly coincident vertices.
   std::vector<MeshProblem> duplicate;
   std::vector<int> order(nv);
   std::iota(order.begin(), order.end(), 0);
-  auto key = [&](int i) { return std::array<double, 3>{vertices[i].x(), vertices[i].y(), vertices[i].z()}; };
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    return key(a) != key(b) ? key(a) < key(b) : a < b;
-  });
+  auto key = [&](int i) {
+    return std::array<double, 3>{vertices[i].x(), vertices[i].y(), vertices[i].z()};
+  };
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return key(a) != key(b) ? key(a) < key(b) : a < b; });
   for (int i = 0; i < nv;) {
     int j = i + 1;
     while (j < nv && key(order[j]) == key(order[i])) ++j;
@@ -154,16 +164,17 @@ std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
     }
     i = j;
   }
-  std::sort(duplicate.begin(), duplicate.end(),
-            [](const MeshProblem& a, const MeshProblem& b) { return a.vertices[0] < b.vertices[0]; });
+  std::sort(duplicate.begin(), duplicate.end(), [](const MeshProblem& a, const MeshProblem& b) {
+    return a.vertices[0] < b.vertices[0];
+  });
 
   std::vector<MeshProblem> isolated;
   for (int v = 0; v < nv; ++v)
     if (vfaces[v].empty())
       isolated.push_back(make(MeshProblemKind::IsolatedVertex, {}, {v}, "used by no face"));
 
-  for (auto* group : {&nonmanifold_edge, &nonmanifold_vertex, &duplicate, &zero_area,
-                      &orientation, &degenerate, &isolated})
+  for (auto* group : {&nonmanifold_edge, &nonmanifold_vertex, &duplicate, &zero_area, &orientation,
+                      &degenerate, &isolated})
     for (MeshProblem& p : *group) out.push_back(std::move(p));
   return out;
 }

@@ -12,7 +12,8 @@ ShellMesh make_sheet(double size_x, double size_z, int nx, int nz) {
   ShellMesh m;
   for (int j = 0; j <= nz; ++j)
     for (int i = 0; i <= nx; ++i) {
-      m.vertices.emplace_back(size_x * (double(i) / nx - 0.5), 0.0, size_z * (double(j) / nz - 0.5));
+      m.vertices.emplace_back(size_x * (double(i) / nx - 0.5), 0.0,
+                              size_z * (double(j) / nz - 0.5));
       m.uvs.emplace_back(double(i) / nx, double(j) / nz);
     }
   auto id = [&](int i, int j) { return j * (nx + 1) + i; };
@@ -25,8 +26,7 @@ ShellMesh make_sheet(double size_x, double size_z, int nx, int nz) {
   return m;
 }
 
-ShellMesh make_cylinder(double radius, double height, double angle_deg, int n_around,
-                        int n_along) {
+ShellMesh make_cylinder(double radius, double height, double angle_deg, int n_around, int n_along) {
   const bool closed = angle_deg >= 360.0 - 1e-9;
   SHELLMPM_CHECK(n_along >= 1 && n_around >= (closed ? 3 : 1) && radius > 0 && height > 0,
                  << n_around << " " << n_along);
@@ -53,8 +53,9 @@ ShellMesh make_cylinder(double radius, double height, double angle_deg, int n_ar
 ShellMesh make_sphere(double radius, int subdivisions) {
   SHELLMPM_CHECK(radius > 0 && subdivisions >= 0, << radius);
   const double p = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3d> v = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0}, {0, -1, p}, {0, 1, p},
-                          {0, -1, -p}, {0, 1, -p}, {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
+  std::vector<Vec3d> v = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0},
+                          {0, -1, p}, {0, 1, p}, {0, -1, -p}, {0, 1, -p},
+                          {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
   for (auto& x : v) x.normalize();
   std::vector<Eigen::Vector3i> t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                     {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},

@@ -13,8 +13,7 @@ ShellMesh make_sheet(double size_x, double size_z, int nx, int nz);
 
 /// Cylinder around the Y axis, centred at the origin: `angle_deg` of arc (360 = closed
 /// tube, no seam vertices), n_around segments around and n_along along the axis.
-ShellMesh make_cylinder(double radius, double height, double angle_deg, int n_around,
-                        int n_along);
+ShellMesh make_cylinder(double radius, double height, double angle_deg, int n_around, int n_along);
 
 /// Icosahedron subdivided `subdivisions` times and projected to the sphere:
 /// 10 * 4^s + 2 vertices, every vertex valence 6 except 12 of valence 5.

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sim/collider/collider.h"
 #include "sim/core/check.h"
@@ -69,9 +70,10 @@ ShellMesh build_shell_rest_mesh(const ShellDesc& d) {
       break;
   }
   const Vec3d r = d.rotate_deg * (M_PI / 180.0);
-  const Mat3d R = (Eigen::AngleAxisd(r.z(), Vec3d::UnitZ()) * Eigen::AngleAxisd(r.y(), Vec3d::UnitY()) *
-                   Eigen::AngleAxisd(r.x(), Vec3d::UnitX()))
-                      .toRotationMatrix();
+  const Mat3d R =
+      (Eigen::AngleAxisd(r.z(), Vec3d::UnitZ()) * Eigen::AngleAxisd(r.y(), Vec3d::UnitY()) *
+       Eigen::AngleAxisd(r.x(), Vec3d::UnitX()))
+          .toRotationMatrix();
   for (Vec3d& p : m.vertices) p = R * (d.scale * p) + d.translate;
   return m;
 }
@@ -119,7 +121,7 @@ ShellObject::ShellObject(const ShellDesc& desc, const ShellMaterialDesc& mat, Sh
   }
   for (int i = 0; i < nv; ++i)
     if (pin_mask[i]) v[i].setZero();
-  min_edge_ = 1e300;
+  min_edge_ = std::numeric_limits<double>::infinity();
   for (const auto& t : tris_)
     for (int e = 0; e < 3; ++e) {
       const double len = (rest[t[e]] - rest[t[(e + 1) % 3]]).norm();
@@ -192,7 +194,7 @@ StaticSolveResult ShellObject::settle(const Vec3d& gravity, double time, double 
     xd[i] = x[i].cast<double>();
     if (!pin_mask[i]) continue;
     const PinDesc& pin = desc_.pins[pin_of[i]];
-    if (pin.release_time >= 0 && time >= pin.release_time) continue;
+    if (pin.release_time && time >= *pin.release_time) continue;
     const Vec3d target = keyframe_pose(pin.keyframes, time).apply(rest[i]);
     for (int a = 0; a < 3; ++a)
       if (pin_mask[i] & (1u << a)) {
@@ -219,7 +221,7 @@ void ShellObject::integrate(const std::vector<Vec3>& f, double t, double dt, boo
   std::vector<char> released(desc_.pins.size());
   for (std::size_t p = 0; p < poses.size(); ++p) {
     poses[p] = keyframe_pose(desc_.pins[p].keyframes, t + dt);
-    released[p] = desc_.pins[p].release_time >= 0 && t >= desc_.pins[p].release_time;
+    released[p] = desc_.pins[p].release_time && t >= *desc_.pins[p].release_time;
   }
   parallel_for(
       x.size(), 4096,
@@ -244,7 +246,7 @@ double ShellObject::project_plasticity(bool serial) {
 
 double ShellObject::stable_dt(double cfl) const {
   const double E = mat_.youngs_modulus, nu = mat_.poisson_ratio, rho = mat_.density;
-  const double c = std::sqrt(E / (rho * (1 - nu * nu)));  // membrane wave speed
+  const double c = std::sqrt(E / (rho * (1 - nu * nu)));      // membrane wave speed
   const double kappa = c * mat_.thickness / std::sqrt(12.0);  // bending: omega = kappa k^2
   const double h = min_edge_;
   // Loop-basis shells with lumped masses are stable up to about 0.3 h / c (measured on

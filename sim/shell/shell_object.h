@@ -30,8 +30,7 @@ class ShellObject {
 
   /// Internal (elastic) forces plus gravity, pressure and point loads into `f`
   /// (resized); returns the elastic energy split.
-  KirchhoffLoveShell::Energy forces(const Vec3d& gravity, std::vector<Vec3>& f,
-                                    bool serial) const;
+  KirchhoffLoveShell::Energy forces(const Vec3d& gravity, std::vector<Vec3>& f, bool serial) const;
   /// Static equilibrium under the elastic forces, gravity, pressure and point loads, with
   /// pinned components held at their pin pose at `time` (pre-roll). Positions, forces
   /// and the solve are in double (a temporary double copy of the Kirchhoff-Love data):
@@ -43,8 +42,8 @@ class ShellObject {
   /// Newton-like L-BFGS with a finite-difference stiffness (static_solver.h); stops at
   /// max |free force component| < tolerance [N]. Writes x and zeroes v; the plastic
   /// state is kept (no return mapping).
-  StaticSolveResult settle(const Vec3d& gravity, double time, double tolerance,
-                           int max_iterations, bool serial);
+  StaticSolveResult settle(const Vec3d& gravity, double time, double tolerance, int max_iterations,
+                           bool serial);
   /// One symplectic Euler step with the forces f: damping, pins at time t + dt.
   void integrate(const std::vector<Vec3>& f, double t, double dt, bool serial);
   /// Denting return mapping; returns plastic work [J]. No-op without a yield stress.
@@ -75,11 +74,11 @@ class ShellObject {
   KirchhoffLoveShell& kl() { return *kl_; }
   const KirchhoffLoveShell& kl() const { return *kl_; }
 
-  std::vector<Vec3> x, v;          ///< control point positions and velocities
-  std::vector<Real> mass;          ///< lumped masses [kg]
-  std::vector<Vec3d> rest;         ///< rest positions
+  std::vector<Vec3> x, v;              ///< control point positions and velocities
+  std::vector<Real> mass;              ///< lumped masses [kg]
+  std::vector<Vec3d> rest;             ///< rest positions
   std::vector<std::uint8_t> pin_mask;  ///< bit a: component a is held
-  std::vector<int> pin_of;         ///< which pin holds the point (-1: none)
+  std::vector<int> pin_of;             ///< which pin holds the point (-1: none)
 
  private:
   ShellDesc desc_;

@@ -11,7 +11,7 @@ namespace shellmpm {
 
 struct FrameStats {
   int frame = 0;
-  double time = 0;            ///< simulation time at the end of the frame [s]
+  double time = 0;  ///< simulation time at the end of the frame [s]
   int substeps = 0;
   double dt_min = 0, dt_max = 0;  ///< range of steps taken [s]
   std::size_t particles = 0;
@@ -22,13 +22,13 @@ struct FrameStats {
   double max_speed = 0;       ///< [m/s]
   std::size_t grid_blocks = 0;
   // Shells (all shells summed).
-  std::size_t shell_points = 0;        ///< control points
-  double shell_kinetic_energy = 0;     ///< [J]
-  double shell_membrane_energy = 0;    ///< [J]
-  double shell_bending_energy = 0;     ///< [J]
-  double shell_plastic_work = 0;       ///< dissipated by denting since the start [J]
-  double shell_max_strain = 0;         ///< largest principal Hencky strain
-  Vec3d shell_momentum{0, 0, 0};       ///< sum m v over control points [kg m/s]
+  std::size_t shell_points = 0;      ///< control points
+  double shell_kinetic_energy = 0;   ///< [J]
+  double shell_membrane_energy = 0;  ///< [J]
+  double shell_bending_energy = 0;   ///< [J]
+  double shell_plastic_work = 0;     ///< dissipated by denting since the start [J]
+  double shell_max_strain = 0;       ///< largest principal Hencky strain
+  Vec3d shell_momentum{0, 0, 0};     ///< sum m v over control points [kg m/s]
   // Contact (shells on the grid).
   std::size_t contact_particles = 0;   ///< contact particles of all shells
   std::size_t contact_compressed = 0;  ///< in contact (s3 < 1) after the frame's last step

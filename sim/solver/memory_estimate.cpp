@@ -202,6 +202,77 @@ double grid_bytes(double points, double pblocks, double gblocks) {
          gblocks * (64 * kNode + 8 + 32 + hash);
 }
 
+/// What the shells hold and build, summed over the shells (estimate_solver_memory).
+struct ShellTotals {
+  double shells_persistent = 0, construction = 0, grid_points = 0, force_scratch = 0;
+  double contact_bytes = 0, integrity_bytes = 0, shell_bytes = 0, guard_bytes = 0;
+  std::size_t grid_shells = 0;
+  std::vector<double> shell_pblocks;  ///< particle blocks of each shell on the grid
+};
+
+/// Adds shell i of the scene to the totals and its counts to n.
+void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellTotals& t) {
+  const ShotSettings& shot = scene.shot;
+  const double dx = shot.dx;
+  const ShellDesc& d = scene.shells[i];
+  const ShellMaterialDesc& m = scene.shell_materials[d.material];
+  const ShellCounts c = shell_counts(d);
+  const double V = c.vertices, T = c.triangles, S = c.support;
+  const double qp = T * m.quadrature_inplane, entries = qp * S;
+  const double layers = m.quadrature_thickness;
+  double Vout = 0, Tout = 0;
+  refined(V, T, d.output_refine, Vout, Tout);
+  n.shell_points += V;
+  n.shell_triangles += T;
+  n.quadrature_points += qp;
+  n.output_vertices += Vout;
+
+  // ShellObject: state, Loop basis fans, Kirchhoff-Love data, the output limit mesh.
+  const double object = V * (2 * kVec3 + R + 24 + 1 + 4) + 12 * T;
+  const double basis = 12 * T + 8 * V + 12 * T + 12 * T + V;
+  const double kl = entries * (16 + 6 * R) + qp * (8 + R + 4 * R * layers + 4 * R) +
+                    (m.yield_stress > 0 ? qp * 4 * R * layers : 0) + 8 * V;
+  const double limit = limit_mesh_bytes(Vout, Tout, S, c.has_uvs);
+  const double persistent = object + basis + kl + limit + V * kVec3;  // + force buffer
+  // While the Kirchhoff-Love data is built: every quadrature point's BasisPoint (seven
+  // vectors grown by push_back), the weights and the rest mesh passed in.
+  const double cap = grown(S);
+  const double points = qp * (7 * kVector + chunk(4 * cap) + 6 * chunk(8 * cap)) + 8 * qp;
+  const double rest_mesh = 24 * V + 12 * T + (c.has_uvs ? 16 * V : 0);
+  t.construction =
+      std::max(t.construction, t.shells_persistent + object + basis + kl + points + rest_mesh);
+  t.shells_persistent += persistent;
+  t.shell_bytes += persistent;
+  t.force_scratch = std::max(t.force_scratch, 15 * R * qp);  // adjoints per quadrature point
+
+  if (!shell_contact_on(scene, i)) return;
+  ++t.grid_shells;
+  const double sites = T * m.contact_samples;
+  n.contact_sites += sites;
+  const double site_support = S;
+  t.contact_bytes += sites * (3 * kVec3 + R + 1 + 4 + site_support * (4 + 3 * R) +
+                              site_support * (4 + 2 * R) + 2 * kVec3) +
+                     V * (kMat3 + 4);
+  // The integrity monitor's own limit mesh (level 0), edges, rim distances, positions.
+  t.integrity_bytes += limit_mesh_bytes(V, T, S, false) + V * (8 + 48 + 3) + 1.5 * T * 8;
+  // The shell guard (sim/contact/shell_guard.h): its own limit mesh, edges (1.5 T), rest
+  // positions; per pass the control and limit positions, velocities and inverse masses
+  // (double); the triangle and edge grids of a list build, each feature in about 4 cells
+  // (a sorted (key, feature) pair plus the kept key and feature), and the stamps.
+  if (shot.shell_guard)
+    t.guard_bytes += limit_mesh_bytes(V, T, S, false) + 1.5 * T * 8 + V * (24 + 8) + V * 4 * 24 +
+                     2.5 * T * 4 * (16 + 12) + 2.5 * T * 4;
+  // Shell table, binned positions, pin holds and the force buffer of the grid shell.
+  t.grid_points += V;
+  t.shell_bytes += V * (2 + 4 + kVec3 + 1 + kVec3);
+  // Blocks: the surface covers area / (4 dx)^2 blocks, half again for folds and tilt; a
+  // sheet's grid blocks are about twice its particle blocks (one layer each side).
+  const double pb = std::max(1.0, 1.5 * c.area / (16 * dx * dx));
+  t.shell_pblocks.push_back(pb);
+  n.particle_blocks += pb;
+  n.grid_blocks += 2.2 * pb;
+}
+
 }  // namespace
 
 bool shell_contact_on(const Scene& scene, std::size_t i) {
@@ -250,77 +321,24 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   }
 
   // Shells.
-  double shells_persistent = 0, construction = 0, grid_points = 0, force_scratch = 0;
-  double fields_bytes = 0, contact_bytes = 0, integrity_bytes = 0, shell_bytes = 0;
-  double guard_bytes = 0;
-  std::size_t grid_shells = 0;
-  const bool fields_wanted = !shot.shared_shell_velocity;
-  std::vector<double> shell_pblocks;
-  for (std::size_t i = 0; i < scene.shells.size(); ++i) {
-    const ShellDesc& d = scene.shells[i];
-    const ShellMaterialDesc& m = scene.shell_materials[d.material];
-    const ShellCounts c = shell_counts(d);
-    const double V = c.vertices, T = c.triangles, S = c.support;
-    const double qp = T * m.quadrature_inplane, entries = qp * S;
-    const double layers = m.quadrature_thickness;
-    double Vout = 0, Tout = 0;
-    refined(V, T, d.output_refine, Vout, Tout);
-    n.shell_points += V;
-    n.shell_triangles += T;
-    n.quadrature_points += qp;
-    n.output_vertices += Vout;
-
-    // ShellObject: state, Loop basis fans, Kirchhoff-Love data, the output limit mesh.
-    const double object = V * (2 * kVec3 + R + 24 + 1 + 4) + 12 * T;
-    const double basis = 12 * T + 8 * V + 12 * T + 12 * T + V;
-    const double kl = entries * (16 + 6 * R) + qp * (8 + R + 4 * R * layers + 4 * R) +
-                      (m.yield_stress > 0 ? qp * 4 * R * layers : 0) + 8 * V;
-    const double limit = limit_mesh_bytes(Vout, Tout, S, c.has_uvs);
-    const double persistent = object + basis + kl + limit + V * kVec3;  // + force buffer
-    // While the Kirchhoff-Love data is built: every quadrature point's BasisPoint (seven
-    // vectors grown by push_back), the weights and the rest mesh passed in.
-    const double cap = grown(S);
-    const double points = qp * (7 * kVector + chunk(4 * cap) + 6 * chunk(8 * cap)) + 8 * qp;
-    const double rest_mesh = 24 * V + 12 * T + (c.has_uvs ? 16 * V : 0);
-    construction =
-        std::max(construction, shells_persistent + object + basis + kl + points + rest_mesh);
-    shells_persistent += persistent;
-    shell_bytes += persistent;
-    force_scratch = std::max(force_scratch, 15 * R * qp);  // adjoints per quadrature point
-
-    if (!shell_contact_on(scene, i)) continue;
-    ++grid_shells;
-    const double sites = T * m.contact_samples;
-    n.contact_sites += sites;
-    const double site_support = S;
-    contact_bytes += sites * (3 * kVec3 + R + 1 + 4 + site_support * (4 + 3 * R) +
-                              site_support * (4 + 2 * R) + 2 * kVec3) +
-                     V * (kMat3 + 4);
-    // The integrity monitor's own limit mesh (level 0), edges, rim distances, positions.
-    integrity_bytes += limit_mesh_bytes(V, T, S, false) + V * (8 + 48 + 3) + 1.5 * T * 8;
-    // The shell guard (sim/contact/shell_guard.h): its own limit mesh, edges (1.5 T), rest
-    // positions; per pass the control and limit positions, velocities and inverse masses
-    // (double); the triangle and edge grids of a list build, each feature in about 4 cells
-    // (a sorted (key, feature) pair plus the kept key and feature), and the stamps.
-    if (shot.shell_guard)
-      guard_bytes += limit_mesh_bytes(V, T, S, false) + 1.5 * T * 8 + V * (24 + 8) +
-                     V * 4 * 24 + 2.5 * T * 4 * (16 + 12) + 2.5 * T * 4;
-    // Shell table, binned positions, pin holds and the force buffer of the grid shell.
-    grid_points += V;
-    shell_bytes += V * (2 + 4 + kVec3 + 1 + kVec3);
-    // Blocks: the surface covers area / (4 dx)^2 blocks, half again for folds and tilt; a
-    // sheet's grid blocks are about twice its particle blocks (one layer each side).
-    const double pb = std::max(1.0, 1.5 * c.area / (16 * dx * dx));
-    shell_pblocks.push_back(pb);
-    n.particle_blocks += pb;
-    n.grid_blocks += 2.2 * pb;
-  }
+  ShellTotals t;
+  for (std::size_t i = 0; i < scene.shells.size(); ++i) add_shell_memory(scene, i, n, t);
+  double fields_bytes = 0;
+  double integrity_bytes = t.integrity_bytes;
+  const double shells_persistent = t.shells_persistent, construction = t.construction;
+  const double grid_points = t.grid_points, force_scratch = t.force_scratch;
+  const double contact_bytes = t.contact_bytes, shell_bytes = t.shell_bytes;
+  const double guard_bytes = t.guard_bytes;
+  const std::size_t grid_shells = t.grid_shells;
+  const bool fields_wanted = shot.shell_velocities == ShellVelocities::PerShell;
+  const std::vector<double>& shell_pblocks = t.shell_pblocks;
   // Per-shell velocity fields (shot.shell_velocities: per_shell) when two bodies share the
-  // grid (two shells, a shell and bulk, or a shell's folds): each bins its control points into its own grid and keeps 6^3
-  // buffers and 4^3 nodes of 14 Reals; the combined grid keeps the bulk moments. Fold
-  // blocks are transient and few (a crumple's folds cover a fraction of its blocks).
-  const bool fields = fields_wanted && (grid_shells >= 2 || (grid_shells >= 1 && (shot.fold_fields ||
-                                                                                   !scene.sources.empty())));
+  // grid (two shells, a shell and bulk, or a shell's folds): each bins its control points into its
+  // own grid and keeps 6^3 buffers and 4^3 nodes of 14 Reals; the combined grid keeps the bulk
+  // moments. Fold blocks are transient and few (a crumple's folds cover a fraction of its blocks).
+  const bool fields =
+      fields_wanted &&
+      (grid_shells >= 2 || (grid_shells >= 1 && (shot.fold_fields || !scene.sources.empty())));
   if (fields) {
     for (double pb : shell_pblocks) {
       const double gb = 2.2 * pb;

@@ -54,8 +54,8 @@ void Solver::setup_contact() {
     if (!shell_has_contact(c_.scene, i)) continue;
     const ShellMaterialDesc& m = c_.shells[i]->material();
     ContactParams cp;
-    cp.kc = m.contact_stiffness > 0 ? m.contact_stiffness : m.youngs_modulus;
-    cp.gamma = m.contact_shear > 0 ? m.contact_shear : cp.kc;
+    cp.kc = m.contact_stiffness.value_or(m.youngs_modulus);
+    cp.gamma = m.contact_shear.value_or(cp.kc);
     cp.friction = m.friction;
     c_.contacts[i] = std::make_unique<ShellContact>(c_.shells[i]->basis(), c_.shells[i]->rest,
                                                     m.thickness, m.contact_samples, cp);
@@ -68,8 +68,10 @@ void Solver::setup_contact() {
     c_.grid_shells.push_back(std::move(g));
   }
   c_.shell_table.build(c_.grid_shells);
-  c_.shell_fields.setup(c_.grid, c_.scene.shot.shared_shell_velocity ? 0 : c_.grid_shells.size(),
-                        !c_.scene.sources.empty(), c_.scene.shot.fold_fields);
+  c_.shell_fields.setup(
+      c_.grid,
+      c_.scene.shot.shell_velocities == ShellVelocities::Shared ? 0 : c_.grid_shells.size(),
+      !c_.scene.sources.empty(), c_.scene.shot.fold_fields);
 }
 
 std::vector<std::string> Solver::stage_names() const {
@@ -143,13 +145,39 @@ double Solver::stable_dt(double* vmax_out) const {
   return dt;
 }
 
+double Solver::checked_stable_dt(double remaining, double* vmax) const {
+  const double dt = stable_dt(vmax);
+  if (!std::isfinite(dt)) {
+    std::ostringstream os;
+    os << "at t = " << c_.time << " s the simulation diverged (a velocity is not finite); "
+       << "try a smaller shot.cfl, or a stiffer contact or smaller dx for fast contact";
+    throw SimulationError(os.str());
+  }
+  if (dt < c_.scene.shot.dt_min && remaining > c_.scene.shot.dt_min) {
+    std::ostringstream os;
+    os << "at t = " << c_.time << " s the stable step " << dt
+       << " s is below shot.dt_min = " << c_.scene.shot.dt_min << " s, "
+       << describe_step_limits(step_limits(*this), c_.scene.shot.dt_min);
+    throw SimulationError(os.str());
+  }
+  return dt;
+}
+
+void Solver::reorder_particles() {
+  // By grid block, once per frame, for memory locality.
+  if (c_.particles.size() == 0) return;
+  c_.grid.bin(c_.particles.x, c_.opt.serial);
+  c_.particles.permute(c_.grid.order);
+  ++c_.particle_epoch;
+}
+
 FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   using clock = std::chrono::steady_clock;
   const auto wall0 = clock::now();
   for (Slot& st : stages_) st.seconds = 0;
   c_.guard_frame = ShellGuardStats{};
   FrameStats fs;
-  fs.dt_min = 1e300;
+  fs.dt_min = std::numeric_limits<double>::infinity();
   double dt_seconds = 0, integrity_seconds = 0;
   const auto i0 = clock::now();
   const IntegrityView view = integrity_view();
@@ -161,21 +189,8 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   while (c_.time < t_end) {
     const auto d0 = clock::now();
     double vmax = 0;
-    double dt = stable_dt(&vmax);
     const double remaining = t_end - c_.time;
-    if (!std::isfinite(dt)) {
-      std::ostringstream os;
-      os << "at t = " << c_.time << " s the simulation diverged (a velocity is not finite); "
-         << "try a smaller shot.cfl, or a stiffer contact or smaller dx for fast contact";
-      throw SimulationError(os.str());
-    }
-    if (dt < c_.scene.shot.dt_min && remaining > c_.scene.shot.dt_min) {
-      std::ostringstream os;
-      os << "at t = " << c_.time << " s the stable step " << dt
-         << " s is below shot.dt_min = " << c_.scene.shot.dt_min << " s, "
-         << describe_step_limits(step_limits(*this), c_.scene.shot.dt_min);
-      throw SimulationError(os.str());
-    }
+    double dt = checked_stable_dt(remaining, &vmax);
     const double steps = std::max(1.0, std::ceil(remaining / dt - 1e-9));
     dt = remaining / steps;
     dt_seconds += std::chrono::duration<double>(clock::now() - d0).count();
@@ -204,13 +219,8 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
     integrity_seconds += std::chrono::duration<double>(clock::now() - c0).count();
   }
   if (fs.substeps == 0) fs.dt_min = 0;
-  // Reorder particles by grid block once per frame for memory locality.
   const auto r0 = clock::now();
-  if (c_.particles.size() > 0) {
-    c_.grid.bin(c_.particles.x, c_.opt.serial);
-    c_.particles.permute(c_.grid.order);
-    ++c_.particle_epoch;
-  }
+  reorder_particles();
   const double reorder_seconds = std::chrono::duration<double>(clock::now() - r0).count();
   fs.time = c_.time;
   measure(fs);

@@ -76,6 +76,11 @@ class Solver {
   };
   /// stable_dt, and the largest particle, shell point or collider speed [m/s].
   double stable_dt(double* vmax) const;
+  /// stable_dt, or a SimulationError when it is not finite (diverged) or below
+  /// shot.dt_min with more than dt_min of the frame left (`remaining` [s]).
+  double checked_stable_dt(double remaining, double* vmax) const;
+  /// Sorts the bulk particles by grid block (once per frame, for memory locality).
+  void reorder_particles();
   IntegrityView integrity_view() const;
   void setup_contact();
 

@@ -61,8 +61,7 @@ std::size_t SourceSampler::count_fill() const {
   return n;
 }
 
-void SourceSampler::emit(double t, double dt,
-                         const std::function<void(const Vec3d&)>& out) const {
+void SourceSampler::emit(double t, double dt, const std::function<void(const Vec3d&)>& out) const {
   if (!src_.emit) return;
   const double a = std::max(t, t0_), b = std::min(t + dt, t1_);
   if (!(b > a)) return;

@@ -7,7 +7,7 @@ namespace shellmpm {
 TransferParams StepContext::transfer_params() const {
   TransferParams tp;
   tp.dt = static_cast<Real>(dt);
-  tp.mls = scene.shot.transfer == "mls";
+  tp.mls = scene.shot.transfer == Transfer::Mls;
   tp.serial = opt.serial;
   tp.models = &models;
   tp.densities = &densities;

@@ -3,6 +3,7 @@
 // write it and which read it, so a new stage can see what it may use and what it must
 // leave as it found it.
 #pragma once
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -33,7 +34,7 @@ struct StepContext {
   std::vector<ConstitutiveModel> models;  ///< per bulk material
   std::vector<Real> densities;            ///< per bulk material [kg/m^3]
   Vec3i domain_cells{0, 0, 0};            ///< cells of the domain along each axis
-  double shell_dt = 1e300;                ///< stable step of the shells' stiffness [s]
+  double shell_dt = std::numeric_limits<double>::infinity();  ///< shells' stable step [s]
 
   // Time. The solver writes them before each step; stages read them.
   double time = 0;  ///< at the start of the step [s]
@@ -78,8 +79,8 @@ struct StepContext {
   /// shell_guard's counts over the frame so far (the solver zeroes it at a frame's start):
   /// pairs and sweeps are maxima over the steps, impulses, zoned and unresolved sums.
   ShellGuardStats guard_frame;
-  double friction_work = 0;       ///< [J]
-  double plastic_work = 0;        ///< [J]
+  double friction_work = 0;  ///< [J]
+  double plastic_work = 0;   ///< [J]
 
   /// Transfer settings for this step (dt, APIC or MLS, materials, where bulk starts).
   TransferParams transfer_params() const;

@@ -106,6 +106,133 @@ std::string material_hint() {
          kLargerDx;
 }
 
+/// Bulk particles, per material: the largest speed and squared wave speed, in the same
+/// precision as Solver::stable_dt (so the minimum matches it exactly). Returns which
+/// materials have particles.
+std::vector<char> add_bulk(const Solver& solver, std::vector<StepLimit>& out) {
+  const Scene& scene = solver.scene();
+  const ShotSettings& s = scene.shot;
+  const ParticleSet& p = solver.particles();
+  const std::size_t nmat = solver.models().size();
+  std::vector<Real> v2(nmat, Real(0)), c2(nmat, Real(0));
+  std::vector<char> present(nmat, 0), finite(nmat, 1);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const auto mat = p.material[i];
+    present[mat] = 1;
+    const Real sq = p.v[i].squaredNorm();
+    if (!std::isfinite(sq)) finite[mat] = 0;
+    v2[mat] = std::max(v2[mat], sq);
+    c2[mat] = std::max(c2[mat], solver.models()[mat].wave_modulus(
+                                    p.F[i], p.has_plastic() ? p.plastic[i] : Real(1)) /
+                                    solver.densities()[mat]);
+  }
+  for (std::size_t mat = 0; mat < nmat; ++mat) {
+    if (!present[mat]) continue;
+    const MaterialDesc& md = scene.materials[mat];
+    const double c = static_cast<double>(std::sqrt(c2[mat]));
+    if (c > 0) {
+      StepLimit l;
+      l.kind = StepLimitKind::Material;
+      l.dt = s.cfl * s.dx / c;
+      l.detail = "material " + quoted(md.name) + ": elastic wave speed " + num(c) + " m/s (E " +
+                 num(md.youngs_modulus) + " Pa, density " + num(md.density) + " kg/m^3)";
+      l.hint = material_hint();
+      out.push_back(std::move(l));
+    }
+    const double v = finite[mat] ? std::sqrt(static_cast<double>(v2[mat]))
+                                 : std::numeric_limits<double>::quiet_NaN();
+    if (!(v > 0) && !std::isnan(v)) continue;
+    StepLimit l;
+    l.kind = StepLimitKind::ParticleSpeed;
+    l.dt = cfl_dt(s, v);
+    l.detail = "particles of material " + quoted(md.name) + ": " +
+               (std::isnan(v) ? std::string("a velocity is not finite (diverged)")
+                              : "max speed " + num(v) + " m/s");
+    l.hint = "slower sources or colliders (or, when diverged, a smaller shot.cfl), or " + kLargerDx;
+    out.push_back(std::move(l));
+  }
+  return present;
+}
+
+/// Shells on the grid move with the CFL bound too.
+void add_shell_speeds(const Solver& solver, std::vector<StepLimit>& out) {
+  const ShotSettings& s = solver.scene().shot;
+  for (std::size_t i = 0; i < solver.shells().size(); ++i) {
+    if (!solver.contact(i)) continue;
+    const ShellObject& sh = *solver.shells()[i];
+    double vmax = 0;
+    for (const Vec3& v : sh.v) {
+      const double sp = static_cast<double>(v.norm());
+      if (!std::isfinite(sp)) {
+        vmax = std::numeric_limits<double>::quiet_NaN();
+        break;
+      }
+      vmax = std::max(vmax, sp);
+    }
+    if (!(vmax > 0) && !std::isnan(vmax)) continue;
+    StepLimit l;
+    l.kind = StepLimitKind::ShellSpeed;
+    l.dt = cfl_dt(s, vmax);
+    l.detail = "shell " + quoted(sh.name()) + ": " +
+               (std::isnan(vmax) ? std::string("a velocity is not finite (diverged)")
+                                 : "max control-point speed " + num(vmax) + " m/s");
+    l.hint = "a slower shell (its velocity, pin keyframes), or " + kLargerDx;
+    out.push_back(std::move(l));
+  }
+}
+
+void add_colliders(const Solver& solver, std::vector<StepLimit>& out) {
+  const ShotSettings& s = solver.scene().shot;
+  for (const Collider& c : solver.colliders()) {
+    const double v = c.max_speed(solver.time());
+    if (!(v > 0)) continue;
+    StepLimit l;
+    l.kind = StepLimitKind::ColliderSpeed;
+    l.dt = cfl_dt(s, v);
+    l.detail = "collider " + quoted(c.desc().name) + ": speed " + num(v) + " m/s";
+    l.hint = "slower keyframes (further apart in time), or " + kLargerDx;
+    out.push_back(std::move(l));
+  }
+}
+
+/// What emitting sources will make: their speed, and the wave speed at rest of materials
+/// that have no particles yet.
+void add_upcoming(const Solver& solver, const std::vector<char>& present,
+                  std::vector<StepLimit>& out) {
+  const Scene& scene = solver.scene();
+  const ShotSettings& s = scene.shot;
+  std::vector<char> listed = present;
+  for (const SourceDesc& src : scene.sources) {
+    if (!src.emit) continue;
+    const double v = src.velocity.norm();
+    if (v > 0) {
+      StepLimit l;
+      l.kind = StepLimitKind::SourceSpeed;
+      l.dt = s.cfl * s.dx / v;
+      l.detail = "source " + quoted(src.name) + ": emission speed " + num(v) + " m/s";
+      l.hint = "a slower sources[].velocity, or " + kLargerDx;
+      l.upcoming = true;
+      out.push_back(std::move(l));
+    }
+    if (listed[src.material]) continue;
+    listed[src.material] = 1;
+    const ConstitutiveModel& m = solver.models()[src.material];
+    const double c =
+        static_cast<double>(m.wave_speed(solver.densities()[src.material], m.initial_plastic()));
+    if (!(c > 0)) continue;
+    const MaterialDesc& md = scene.materials[src.material];
+    StepLimit l;
+    l.kind = StepLimitKind::Material;
+    l.dt = s.cfl * s.dx / c;
+    l.detail = "material " + quoted(md.name) + " (emitted by source " + quoted(src.name) +
+               "): elastic wave speed " + num(c) + " m/s (E " + num(md.youngs_modulus) +
+               " Pa, density " + num(md.density) + " kg/m^3)";
+    l.hint = material_hint();
+    l.upcoming = true;
+    out.push_back(std::move(l));
+  }
+}
+
 }  // namespace
 
 const char* to_string(StepLimitKind kind) {
@@ -148,112 +275,10 @@ std::vector<StepLimit> step_limits(const Solver& solver, bool upcoming) {
     add_shell_elastic(sh, s, out);
     if (const ShellContact* c = solver.contact(i)) add_shell_contact(sh, *c, s, out);
   }
-  // Bulk particles, per material: the largest speed and squared wave speed, in the same
-  // precision as Solver::stable_dt (so the minimum matches it exactly).
-  const ParticleSet& p = solver.particles();
-  const std::size_t nmat = solver.models().size();
-  std::vector<Real> v2(nmat, Real(0)), c2(nmat, Real(0));
-  std::vector<char> present(nmat, 0), finite(nmat, 1);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const auto mat = p.material[i];
-    present[mat] = 1;
-    const Real sq = p.v[i].squaredNorm();
-    if (!std::isfinite(sq)) finite[mat] = 0;
-    v2[mat] = std::max(v2[mat], sq);
-    c2[mat] = std::max(c2[mat], solver.models()[mat].wave_modulus(
-                                    p.F[i], p.has_plastic() ? p.plastic[i] : Real(1)) /
-                                    solver.densities()[mat]);
-  }
-  for (std::size_t mat = 0; mat < nmat; ++mat) {
-    if (!present[mat]) continue;
-    const MaterialDesc& md = scene.materials[mat];
-    const double c = static_cast<double>(std::sqrt(c2[mat]));
-    if (c > 0) {
-      StepLimit l;
-      l.kind = StepLimitKind::Material;
-      l.dt = s.cfl * s.dx / c;
-      l.detail = "material " + quoted(md.name) + ": elastic wave speed " + num(c) + " m/s (E " +
-                 num(md.youngs_modulus) + " Pa, density " + num(md.density) + " kg/m^3)";
-      l.hint = material_hint();
-      out.push_back(std::move(l));
-    }
-    const double v = finite[mat] ? std::sqrt(static_cast<double>(v2[mat]))
-                                 : std::numeric_limits<double>::quiet_NaN();
-    if (!(v > 0) && !std::isnan(v)) continue;
-    StepLimit l;
-    l.kind = StepLimitKind::ParticleSpeed;
-    l.dt = cfl_dt(s, v);
-    l.detail = "particles of material " + quoted(md.name) + ": " +
-               (std::isnan(v) ? std::string("a velocity is not finite (diverged)")
-                              : "max speed " + num(v) + " m/s");
-    l.hint = "slower sources or colliders (or, when diverged, a smaller shot.cfl), or " + kLargerDx;
-    out.push_back(std::move(l));
-  }
-  // Shells on the grid move with the CFL bound too.
-  for (std::size_t i = 0; i < solver.shells().size(); ++i) {
-    if (!solver.contact(i)) continue;
-    const ShellObject& sh = *solver.shells()[i];
-    double vmax = 0;
-    for (const Vec3& v : sh.v) {
-      const double sp = static_cast<double>(v.norm());
-      if (!std::isfinite(sp)) {
-        vmax = std::numeric_limits<double>::quiet_NaN();
-        break;
-      }
-      vmax = std::max(vmax, sp);
-    }
-    if (!(vmax > 0) && !std::isnan(vmax)) continue;
-    StepLimit l;
-    l.kind = StepLimitKind::ShellSpeed;
-    l.dt = cfl_dt(s, vmax);
-    l.detail = "shell " + quoted(sh.name()) + ": " +
-               (std::isnan(vmax) ? std::string("a velocity is not finite (diverged)")
-                                 : "max control-point speed " + num(vmax) + " m/s");
-    l.hint = "a slower shell (its velocity, pin keyframes), or " + kLargerDx;
-    out.push_back(std::move(l));
-  }
-  for (const Collider& c : solver.colliders()) {
-    const double v = c.max_speed(solver.time());
-    if (!(v > 0)) continue;
-    StepLimit l;
-    l.kind = StepLimitKind::ColliderSpeed;
-    l.dt = cfl_dt(s, v);
-    l.detail = "collider " + quoted(c.desc().name) + ": speed " + num(v) + " m/s";
-    l.hint = "slower keyframes (further apart in time), or " + kLargerDx;
-    out.push_back(std::move(l));
-  }
-  if (upcoming) {
-    std::vector<char> listed = present;
-    for (const SourceDesc& src : scene.sources) {
-      if (!src.emit) continue;
-      const double v = src.velocity.norm();
-      if (v > 0) {
-        StepLimit l;
-        l.kind = StepLimitKind::SourceSpeed;
-        l.dt = s.cfl * s.dx / v;
-        l.detail = "source " + quoted(src.name) + ": emission speed " + num(v) + " m/s";
-        l.hint = "a slower sources[].velocity, or " + kLargerDx;
-        l.upcoming = true;
-        out.push_back(std::move(l));
-      }
-      if (listed[src.material]) continue;
-      listed[src.material] = 1;
-      const ConstitutiveModel& m = solver.models()[src.material];
-      const double c =
-          static_cast<double>(m.wave_speed(solver.densities()[src.material], m.initial_plastic()));
-      if (!(c > 0)) continue;
-      const MaterialDesc& md = scene.materials[src.material];
-      StepLimit l;
-      l.kind = StepLimitKind::Material;
-      l.dt = s.cfl * s.dx / c;
-      l.detail = "material " + quoted(md.name) + " (emitted by source " + quoted(src.name) +
-                 "): elastic wave speed " + num(c) + " m/s (E " + num(md.youngs_modulus) +
-                 " Pa, density " + num(md.density) + " kg/m^3)";
-      l.hint = material_hint();
-      l.upcoming = true;
-      out.push_back(std::move(l));
-    }
-  }
+  const std::vector<char> present = add_bulk(solver, out);
+  add_shell_speeds(solver, out);
+  add_colliders(solver, out);
+  if (upcoming) add_upcoming(solver, present, out);
   // NaN (diverged) first, then by dt; ties keep the order above.
   std::stable_sort(out.begin(), out.end(), [](const StepLimit& a, const StepLimit& b) {
     if (std::isnan(a.dt) || std::isnan(b.dt)) return std::isnan(a.dt) && !std::isnan(b.dt);

@@ -270,6 +270,7 @@ TEST_CASE("CLI: --frames numbers out of range are refused naming the flag", "[cl
   const CmdResult r = run_shellmpm("render " + d.file("o") + " --frames 1-99999999999");
   INFO(r.output);
   CHECK(r.code == 2);
-  CHECK(r.output.find("--frames 1-99999999999: frame 99999999999 is past the largest frame number") !=
-        std::string::npos);
+  CHECK(
+      r.output.find("--frames 1-99999999999: frame 99999999999 is past the largest frame number") !=
+      std::string::npos);
 }

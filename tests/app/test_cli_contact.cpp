@@ -65,7 +65,8 @@ TEST_CASE("CLI: the shell guard's impulses are the same on 1 and 2 threads and a
     CHECK(a == read_text(d.file(std::string("c/") + f)));
   }
   // The comparison can fail: without the guard the meshes differ.
-  REQUIRE(run_shellmpm("run " + scene + common + d.file("e") + " --set shot.shell_guard=false")
-              .code == 0);
+  REQUIRE(
+      run_shellmpm("run " + scene + common + d.file("e") + " --set shot.shell_guard=false").code ==
+      0);
   CHECK(read_text(d.file("a/upper.0004.ply")) != read_text(d.file("e/upper.0004.ply")));
 }

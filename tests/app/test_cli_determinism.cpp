@@ -3,10 +3,10 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <openvdb/openvdb.h>
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <nlohmann/json.hpp>
-#include <openvdb/openvdb.h>
 #include <thread>
 
 #include "tests/app/cli_harness.h"
@@ -71,7 +71,8 @@ nlohmann::json physics_stats(const std::string& path) {
 
 }  // namespace
 
-TEST_CASE("runs with 1 and 2 threads give bit-identical caches and statistics", "[cli][determinism]") {
+TEST_CASE("runs with 1 and 2 threads give bit-identical caches and statistics",
+          "[cli][determinism]") {
   TempDir d("det");
   const std::string s = make_scene(d, 8);
   REQUIRE(run_shellmpm("run " + s + " -q --threads 1 -o " + d.file("t1")).code == 0);
@@ -86,7 +87,8 @@ TEST_CASE("runs with 1 and 2 threads give bit-identical caches and statistics", 
   REQUIRE(a.dump() == b.dump());
   // The comparison can fail: a different seed changes the result.
   REQUIRE(run_shellmpm("run " + s + " -q --threads 2 --frames 1-8 --set sources[0].seed=5 -o " +
-                       d.file("t3")).code == 0);
+                       d.file("t3"))
+              .code == 0);
   REQUIRE_FALSE(same_density(d.file("t1/density.0008.vdb"), d.file("t3/density.0008.vdb")));
 }
 

@@ -103,7 +103,8 @@ TEST_CASE("CLI: bad input gives file, line, key and exit code 2", "[cli]") {
   }
   SECTION("source outside the domain") {
     const std::string s = scene_with(d, kGood, "max: [0.1, 0.5, 0.1]", "max: [0.1, 1.5, 0.1]");
-    expect_user_error(run_shellmpm("run " + s), {"scene.yaml:9", "sources[0].shape", "outside shot.domain"});
+    expect_user_error(run_shellmpm("run " + s),
+                      {"scene.yaml:9", "sources[0].shape", "outside shot.domain"});
   }
   SECTION("--set with an unknown key") {
     const std::string s = scene_with(d, kGood);
@@ -111,7 +112,8 @@ TEST_CASE("CLI: bad input gives file, line, key and exit code 2", "[cli]") {
   }
   SECTION("--set with a bad value") {
     const std::string s = scene_with(d, kGood);
-    expect_user_error(run_shellmpm("run " + s + " --set shot.dx=-1"), {"--set shot.dx=-1", "shot.dx"});
+    expect_user_error(run_shellmpm("run " + s + " --set shot.dx=-1"),
+                      {"--set shot.dx=-1", "shot.dx"});
   }
   SECTION("bad --frames") {
     const std::string s = scene_with(d, kGood);
@@ -144,8 +146,9 @@ TEST_CASE("CLI: a failed run leaves existing output untouched and no temp files"
   const std::string stats = read_text(d.file("out/stats.json"));
   REQUIRE(run_shellmpm("run " + s + " --quiet --set shot.cfl=7").code == 2);
   // dt_min impossible to meet: the simulation stops with exit code 1 after frame 1.
-  const CmdResult r = run_shellmpm("run " + s + " --quiet --set shot.dt_min=0.005 --set shot.dt_max=0.01 " +
-                                   "--set materials[0].youngs_modulus=1e9 -o " + d.file("out2"));
+  const CmdResult r =
+      run_shellmpm("run " + s + " --quiet --set shot.dt_min=0.005 --set shot.dt_max=0.01 " +
+                   "--set materials[0].youngs_modulus=1e9 -o " + d.file("out2"));
   INFO(r.output);
   REQUIRE(r.code == 1);
   REQUIRE(r.output.find("dt_min") != std::string::npos);

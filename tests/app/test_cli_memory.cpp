@@ -20,7 +20,6 @@ using namespace shellmpm_test;
 
 namespace {
 
-
 std::string write_scene(const TempDir& d, std::string text, const std::string& name = "s.yaml") {
   const auto at = text.find("OUT");
   if (at != std::string::npos) text.replace(at, 3, d.file("out"));

@@ -95,8 +95,9 @@ void stop_and_resume(const TempDir& d, const std::string& scene, const std::stri
 
 }  // namespace
 
-TEST_CASE("CLI: SIGTERM and SIGINT stop after the frame with a checkpoint and --resume completes it",
-          "[cli][resume][signals]") {
+TEST_CASE(
+    "CLI: SIGTERM and SIGINT stop after the frame with a checkpoint and --resume completes it",
+    "[cli][resume][signals]") {
   TempDir d("stop");
   const std::string s = make_scene(d);
   REQUIRE(run_shellmpm("run " + s + " -q -o " + d.file("full")).code == 0);

@@ -14,7 +14,6 @@ namespace {
 
 const std::string kCloth = std::string(SHELLMPM_SOURCE_DIR) + "/scenes/cloth_swing.yaml";
 
-
 std::string write_scene(const TempDir& d, std::string text, const std::string& extra = "") {
   text.replace(text.find("OUT"), 3, d.file("out"));
   return d.write("scene.yaml", text + extra);

@@ -51,8 +51,8 @@ std::vector<Seed> seeds() {
       if (e.path().extension() == ".yaml" && e.path().filename().string().rfind("bad_", 0) != 0)
         files.push_back(e.path());
   std::sort(files.begin(), files.end());
-  const std::vector<std::string> cheap = {"minimal.yaml", "shells.yaml", "guard_pair.yaml",
-                                          "elastic_drop.yaml", "flag.yaml", "cloth_swing.yaml"};
+  const std::vector<std::string> cheap = {"minimal.yaml",      "shells.yaml", "guard_pair.yaml",
+                                          "elastic_drop.yaml", "flag.yaml",   "cloth_swing.yaml"};
   std::vector<Seed> out;
   for (const fs::path& f : files)
     out.push_back({f, read_text(f.string()),
@@ -61,13 +61,39 @@ std::vector<Seed> seeds() {
 }
 
 const std::vector<std::string> kTokens = {
-    ":", "- ", "[", "]", "{", "}", "#", "\"", "'", "\t", "\n", "&a ", "*a", "!!str ", "---\n",
-    "%", "|", ">", "? ", "\xc3\x28", "\xff", std::string(1, '\0'), ",", "  ", "\\", "@", "`"};
-const std::vector<std::string> kValues = {
-    "-1", "0", "1e308", "1e400", "-1e400", ".nan", ".inf", "-.inf", "nan", "1e-320",
-    "99999999999999999999", "[]", "{}", "[1, 2]", "~", "\"\"", "yes", "abc", "0x10",
-    std::string(3000, 'x'), "[1e30, 1e30, 1e30]", "-0", "[-1e38, 0, 0]", "2147483648", "1.5",
-    "[0, 0, 0]", "[.nan, 0, 0]", "\"{name}.ply\"", "/nonexistent/x.obj", "-2147483649"};
+    ":",   "- ", "[",      "]",     "{", "}", "#", "\"", "'",        "\t",   "\n",
+    "&a ", "*a", "!!str ", "---\n", "%", "|", ">", "? ", "\xc3\x28", "\xff", std::string(1, '\0'),
+    ",",   "  ", "\\",     "@",     "`"};
+const std::vector<std::string> kValues = {"-1",
+                                          "0",
+                                          "1e308",
+                                          "1e400",
+                                          "-1e400",
+                                          ".nan",
+                                          ".inf",
+                                          "-.inf",
+                                          "nan",
+                                          "1e-320",
+                                          "99999999999999999999",
+                                          "[]",
+                                          "{}",
+                                          "[1, 2]",
+                                          "~",
+                                          "\"\"",
+                                          "yes",
+                                          "abc",
+                                          "0x10",
+                                          std::string(3000, 'x'),
+                                          "[1e30, 1e30, 1e30]",
+                                          "-0",
+                                          "[-1e38, 0, 0]",
+                                          "2147483648",
+                                          "1.5",
+                                          "[0, 0, 0]",
+                                          "[.nan, 0, 0]",
+                                          "\"{name}.ply\"",
+                                          "/nonexistent/x.obj",
+                                          "-2147483649"};
 
 /// One mutation of s with r.
 void mutate(std::string& s, std::mt19937_64& r) {
@@ -87,7 +113,8 @@ void mutate(std::string& s, std::mt19937_64& r) {
   }
   const auto join = [&]() {
     std::string t;
-    for (std::size_t i = 0; i < lines.size(); ++i) t += lines[i] + (i + 1 < lines.size() ? "\n" : "");
+    for (std::size_t i = 0; i < lines.size(); ++i)
+      t += lines[i] + (i + 1 < lines.size() ? "\n" : "");
     s = t;
   };
   switch (r() % 12) {
@@ -113,7 +140,8 @@ void mutate(std::string& s, std::mt19937_64& r) {
       s.resize(pick(s.size() + 1));
       break;
     case 5:  // delete a line
-      if (lines.size() > 1) lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(pick(lines.size())));
+      if (lines.size() > 1)
+        lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(pick(lines.size())));
       join();
       break;
     case 6: {  // duplicate a line
@@ -169,8 +197,8 @@ CmdResult run_limited(const std::string& args, int seconds) {
 
 /// Key-less whole-file messages (the key cannot be known there).
 const std::vector<std::string> kFileLevel = {"YAML documents", "not valid UTF-8",
-                                              "YAML syntax error",
-                                              "expected a mapping of keys at the top level"};
+                                             "YAML syntax error",
+                                             "expected a mapping of keys at the top level"};
 
 /// Whether an exit-2 message names the file, the line and the key (or a known key-less
 /// form). Returns an empty string when it does, else why not.
@@ -219,7 +247,8 @@ void fuzz(int cases, bool cheap_runs_only, int run_every) {
     const fs::path dir = fs::path(d.file("c" + std::to_string(c % 50)));
     fs::create_directories(dir);
     const fs::path assets = seed.path.parent_path() / "assets";
-    if (fs::exists(assets) && !fs::exists(dir / "assets")) fs::create_directory_symlink(assets, dir / "assets");
+    if (fs::exists(assets) && !fs::exists(dir / "assets"))
+      fs::create_directory_symlink(assets, dir / "assets");
     if (!fs::exists(assets) && fs::exists(dir / "assets")) fs::remove(dir / "assets");
     const std::string file = (dir / "scene.yaml").string();
     std::ofstream(file, std::ios::binary | std::ios::trunc) << text;
@@ -267,4 +296,6 @@ TEST_CASE("scene fuzzer: 300 mutated scenes, no crash, hang or internal error", 
   fuzz(300, true, 1);
 }
 
-TEST_CASE("scene fuzzer: 3000 mutated scenes", "[fuzz]") { fuzz(3000, false, 5); }
+TEST_CASE("scene fuzzer: 3000 mutated scenes", "[fuzz]") {
+  fuzz(3000, false, 5);
+}

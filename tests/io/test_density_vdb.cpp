@@ -24,7 +24,6 @@ using shellmpm_test::TempDir;
 
 namespace {
 
-
 std::string slurp(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   std::stringstream ss;

@@ -19,7 +19,6 @@ using shellmpm_test::TempDir;
 
 namespace {
 
-
 /// Unit cube [-0.5, 0.5]^3 as 6 quads (assimp triangulates them), optionally with UVs.
 std::string cube_obj(bool uvs, bool drop_top = false) {
   std::string s = "# cube\n";

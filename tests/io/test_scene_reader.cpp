@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "io/scene_reader.h"
+#include "sim/scene/scene_words.h"
 
 #ifndef SHELLMPM_SOURCE_DIR
 #error "SHELLMPM_SOURCE_DIR must be defined to the repository root"
@@ -117,7 +118,7 @@ TEST_CASE("a full scene parses with the values written", "[scene]") {
   CHECK(vec_eq(shot.domain_max, Vec3d(2, 3, 2)));
   CHECK(shot.dx == 0.05);
   CHECK(shot.threads == 4);
-  CHECK(shot.transfer == "mls");
+  CHECK(shot.transfer == Transfer::Mls);
   CHECK(shot.units == "cm");
 
   REQUIRE(s.materials.size() == 3);
@@ -426,8 +427,8 @@ TEST_CASE("bad scenes name the file, line and key", "[scene]") {
                  {"dt_max (0.01) must be >= dt_min (0.1)"});
     // A domain too many cells across is also too far from the origin for float (2^17 dx
     // from it, 2^18 cells across at most): that is the error it gets.
-    expect_error("version: 1\nshot:\n  domain: {min: [0, 0, 0], max: [10, 1, 1]}\n  dx: 1e-5\n",
-                 3, "shot.domain.max[0]", {"coordinate x = 10 m", "2^17 = 131072 cells"});
+    expect_error("version: 1\nshot:\n  domain: {min: [0, 0, 0], max: [10, 1, 1]}\n  dx: 1e-5\n", 3,
+                 "shot.domain.max[0]", {"coordinate x = 10 m", "2^17 = 131072 cells"});
     expect_error("version: 1\nshot:\n  domain: {min: [0, 0, 0], max: [1, 0, 1]}\n  dx: 0.1\n", 3,
                  "shot.domain.max", {"on y max = 0 <= min = 0"});
     const UserError e = catch_user_error([] { read_scene(kScenes + "bad_range.yaml"); });
@@ -664,7 +665,7 @@ TEST_CASE("a shell scene parses with the values written", "[scene][shell]") {
   CHECK(s.preroll.tolerance == 1e-6);
   CHECK(s.preroll.max_steps == 5000);
   CHECK(s.output.shell_pattern == "shells/{name}_####.obj");
-  CHECK(s.output.shell_format == "obj");
+  CHECK(s.output.shell_format == MeshFormat::Obj);
 
   SECTION("check_shell_indices reports mesh indices at the key that gave them") {
     check_shell_indices(rag, 100001, s.path);  // in range: no error
@@ -973,7 +974,7 @@ TEST_CASE(
   for (const std::string fmt : {"ply", "obj", "glb"}) {
     CAPTURE(fmt);
     const Scene s = parse_scene(kHead + "output:\n  shell_format: " + fmt + "\n", "scenes/ok.yaml");
-    CHECK(s.output.shell_format == fmt);
+    CHECK(word_of(s.output.shell_format) == fmt);
     CHECK(s.output.shell_pattern == "{name}.####." + fmt);
     // The same through --set.
     const Scene o = parse_scene(kHead, "scenes/ok.yaml", {"output.shell_format=" + fmt});

@@ -20,10 +20,10 @@
 #include <tuple>
 #include <vector>
 
+#include "io/ply_reader.h"
 #include "io/shell_mesh_reader.h"
 #include "io/shell_mesh_writer.h"
 #include "io/user_error.h"
-#include "render/ply_reader.h"
 #include "sim/core/check.h"
 #include "tests/support/ply_cache.h"
 #include "tests/support/temp_dir.h"

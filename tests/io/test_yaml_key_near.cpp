@@ -7,23 +7,23 @@ using namespace shellmpm;
 
 TEST_CASE("yaml_key_near_line names the key path of a line from indentation", "[scene]") {
   const std::string text =
-      "version: 1\n"                       // 1
-      "shot:\n"                            // 2
-      "  frames: [1, 2\n"                  // 3
-      "  # a comment\n"                    // 4
-      "materials:\n"                       // 5
-      "  - name: a\n"                      // 6
-      "    type: sand\n"                   // 7
-      "  - name: b\n"                      // 8
-      "    shape: {type: box}\n"           // 9
-      "    color:\n"                       // 10
-      "      - 0.5\n"                      // 11
-      "shells:\n"                          // 12
-      "- name: s\n"                        // 13  (items at the key's own column)
-      "  pins:\n"                          // 14
-      "    - box: {min: [0, 0, 0]}\n"      // 15
-      "    - indices: [1]\n"               // 16
-      "\"quoted key\": 3\n";               // 17
+      "version: 1\n"                   // 1
+      "shot:\n"                        // 2
+      "  frames: [1, 2\n"              // 3
+      "  # a comment\n"                // 4
+      "materials:\n"                   // 5
+      "  - name: a\n"                  // 6
+      "    type: sand\n"               // 7
+      "  - name: b\n"                  // 8
+      "    shape: {type: box}\n"       // 9
+      "    color:\n"                   // 10
+      "      - 0.5\n"                  // 11
+      "shells:\n"                      // 12
+      "- name: s\n"                    // 13  (items at the key's own column)
+      "  pins:\n"                      // 14
+      "    - box: {min: [0, 0, 0]}\n"  // 15
+      "    - indices: [1]\n"           // 16
+      "\"quoted key\": 3\n";           // 17
   CHECK(yaml_key_near_line(text, 0).empty());
   CHECK(yaml_key_near_line(text, 1) == "version");
   CHECK(yaml_key_near_line(text, 2) == "shot");

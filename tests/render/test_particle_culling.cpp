@@ -16,7 +16,8 @@ RenderParticles block(int n, float spacing) {
 }
 }  // namespace
 
-TEST_CASE("particle culling keeps the outer layers of a packed block and drops its core", "[render]") {
+TEST_CASE("particle culling keeps the outer layers of a packed block and drops its core",
+          "[render]") {
   const float s = 0.01f;
   RenderParticles p = block(30, s);
   const std::size_t removed = cull_hidden_particles(p);
@@ -42,10 +43,12 @@ TEST_CASE("particle culling drops nothing from a thin sheet or a sparse spray", 
   RenderParticles sheet;
   sheet.radius = 0.005f;
   for (int i = 0; i < 100; ++i)
-    for (int j = 0; j < 100; ++j) sheet.positions.emplace_back(0.01f * i, 0.01f * (j % 2), 0.01f * (j / 2));
+    for (int j = 0; j < 100; ++j)
+      sheet.positions.emplace_back(0.01f * i, 0.01f * (j % 2), 0.01f * (j / 2));
   CHECK(cull_hidden_particles(sheet) == 0);
   RenderParticles spray;
   spray.radius = 0.001f;
-  for (int i = 0; i < 1000; ++i) spray.positions.emplace_back(0.01f * i, 0.013f * (i % 7), 0.017f * (i % 11));
+  for (int i = 0; i < 1000; ++i)
+    spray.positions.emplace_back(0.01f * i, 0.013f * (i % 7), 0.017f * (i % 11));
   CHECK(cull_hidden_particles(spray) == 0);
 }

@@ -16,8 +16,7 @@ namespace {
 
 // Four frames of a small elastic box; an odd preview size so that ffmpeg's pad to even
 // dimensions (yuv420p) is exercised: 65x49 -> 66x50.
-const std::string kScene =
-    tiny_jelly_scene(4, "out/never_used", "render:\n  size: [65, 49]\n");
+const std::string kScene = tiny_jelly_scene(4, "out/never_used", "render:\n  size: [65, 49]\n");
 
 /// The value of `key=` in ffprobe's "default" output, or "" when absent.
 std::string probe_value(const std::string& probe, const std::string& key) {

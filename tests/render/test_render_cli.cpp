@@ -68,7 +68,8 @@ TEST_CASE("render: a run's frames, contact sheet, deterministic bytes", "[render
     INFO(r.output);
     REQUIRE(r.code == 0);
     for (int f = 1; f <= 3; ++f) {
-      const shellmpm::Image im = shellmpm::read_png(run.out + "/preview.000" + std::to_string(f) + ".png");
+      const shellmpm::Image im =
+          shellmpm::read_png(run.out + "/preview.000" + std::to_string(f) + ".png");
       CHECK(im.width == 160);
       CHECK(im.height == 90);
     }
@@ -77,13 +78,14 @@ TEST_CASE("render: a run's frames, contact sheet, deterministic bytes", "[render
     CHECK(r.output.find("preview.mp4") != std::string::npos);
     CHECK(fs::exists(run.out + "/preview.mp4") == !shellmpm::find_ffmpeg().empty());
     const std::string first = read_text(run.out + "/preview.0002.png");
-    const CmdResult again = run_shellmpm("render " + run.out + " -q --threads 1 --frames 2 --renderer " +
-                                         std::string(renderer));
+    const CmdResult again = run_shellmpm(
+        "render " + run.out + " -q --threads 1 --frames 2 --renderer " + std::string(renderer));
     REQUIRE(again.code == 0);
     CHECK(read_text(run.out + "/preview.0002.png") == first);
   }
   // Options: size, camera, a scene override; the named camera differs from auto.
-  const CmdResult c = run_shellmpm("render " + run.out + " -q --frames 1 --camera front --size 64x48");
+  const CmdResult c =
+      run_shellmpm("render " + run.out + " -q --frames 1 --camera front --size 64x48");
   INFO(c.output);
   REQUIRE(c.code == 0);
   const shellmpm::Image im = shellmpm::read_png(run.out + "/preview.0001.png");
@@ -96,17 +98,19 @@ TEST_CASE("render: a missing or corrupt cache names the file, the other frames s
   RunDir run("render_cli_bad");
   fs::remove(run.out + "/density.0002.vdb");    // the ray tracer marches the volume
   fs::remove(run.out + "/particles.0002.ply");  // raster draws the particle cache
-  std::ofstream(run.out + "/cloth.0003.ply", std::ios::binary) << "ply\nformat binary_little_endian 1.0\n"
-                                                                 "element vertex 100\nproperty float x\n"
-                                                                 "property float y\nproperty float z\n"
-                                                                 "end_header\nshort";
+  std::ofstream(run.out + "/cloth.0003.ply", std::ios::binary)
+      << "ply\nformat binary_little_endian 1.0\n"
+         "element vertex 100\nproperty float x\n"
+         "property float y\nproperty float z\n"
+         "end_header\nshort";
   for (const char* renderer : {"raster", "raytrace"}) {
     for (int f = 1; f <= 3; ++f) fs::remove(run.out + "/preview.000" + std::to_string(f) + ".png");
     const CmdResult r = run_shellmpm("render " + run.out + " --renderer " + renderer);
     INFO(r.output);
     CHECK(r.code == 1);
-    CHECK(r.output.find(std::string(renderer) == "raster" ? "particles.0002.ply: missing"
-                                                          : "density.0002.vdb: missing") != std::string::npos);
+    CHECK(r.output.find(std::string(renderer) == "raster"
+                            ? "particles.0002.ply: missing"
+                            : "density.0002.vdb: missing") != std::string::npos);
     CHECK(r.output.find("cloth.0003.ply: truncated") != std::string::npos);
     CHECK(fs::exists(run.out + "/preview.0001.png"));
     CHECK_FALSE(fs::exists(run.out + "/preview.0002.png"));
@@ -125,7 +129,8 @@ TEST_CASE("render: a missing or corrupt cache names the file, the other frames s
   CHECK(p.output.find("particles.0001.ply: truncated") != std::string::npos);
 }
 
-TEST_CASE("render: bad input is refused with exit code 2 and a message naming it", "[render][cli]") {
+TEST_CASE("render: bad input is refused with exit code 2 and a message naming it",
+          "[render][cli]") {
   TempDir d("render_cli_input");
   auto expect = [](const std::string& args, const std::string& text) {
     const CmdResult r = run_shellmpm(args);
@@ -140,9 +145,11 @@ TEST_CASE("render: bad input is refused with exit code 2 and a message naming it
   d.write("run.json", "{ broken json");
   expect("render " + d.path.string(), "corrupt run manifest");
   RunDir run("render_cli_input_run");
-  expect("render " + run.out + " --size 10x10", "--size 10x10: width and height must be in [16, 8192]");
+  expect("render " + run.out + " --size 10x10",
+         "--size 10x10: width and height must be in [16, 8192]");
   expect("render " + run.out + " --size big", "--size big: expected WxH");
-  expect("render " + run.out + " --camera side", "--camera side: unknown camera (cameras: auto, front)");
+  expect("render " + run.out + " --camera side",
+         "--camera side: unknown camera (cameras: auto, front)");
   expect("render " + run.out + " --renderer vulkan", "--renderer");
   expect("render " + run.out + " --frames 3-1", "--frames 3-1: need 1 <= A <= B");
   expect("render " + run.out + " --set render.size=[8,8]", "render.size[0]: must be in [16, 8192]");
@@ -156,7 +163,8 @@ TEST_CASE("render: bad input is refused with exit code 2 and a message naming it
 TEST_CASE("run --preview renders each frame as it is written", "[render][cli]") {
   TempDir d("run_preview");
   const std::string scene = d.write("scene.yaml", kScene);
-  const CmdResult r = run_shellmpm("run " + scene + " --threads 2 --frames 1-2 --preview -o " + d.file("o"));
+  const CmdResult r =
+      run_shellmpm("run " + scene + " --threads 2 --frames 1-2 --preview -o " + d.file("o"));
   INFO(r.output);
   REQUIRE(r.code == 0);
   CHECK(fs::exists(d.file("o/preview.0001.png")));

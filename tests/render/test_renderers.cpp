@@ -46,7 +46,8 @@ PreviewScene mixed_scene() {
 
 }  // namespace
 
-TEST_CASE("a sphere's silhouette area is within 1% of the analytic value in both paths", "[render]") {
+TEST_CASE("a sphere's silhouette area is within 1% of the analytic value in both paths",
+          "[render]") {
   const double r = 0.5, d = 3.0;
   const PreviewScene s = sphere_scene(Vec3d(0, 0, 0), r);
   const Camera cam = camera_at(Vec3d(0, 0, d), Vec3d(0, 0, 0), 320, 240);
@@ -99,7 +100,8 @@ TEST_CASE("the key light's shadow falls where the geometry puts it, in both path
   const Vec3d shadow(-0.6, 0, 0), beside(-0.6, 0, 0.8), mirrored(0.6, 0, 0);
   // None of the three ground points is hidden by the sphere in this view.
   const Eigen::Vector3d sc = cam.project(Vec3d(0, 0.6, 0));
-  for (const Vec3d& p : {shadow, beside, mirrored}) REQUIRE((cam.project(p) - sc).head<2>().norm() > 60.0);
+  for (const Vec3d& p : {shadow, beside, mirrored})
+    REQUIRE((cam.project(p) - sc).head<2>().norm() > 60.0);
   RasterRenderer raster(2);
   RayTracer rt(2);
   for (Renderer* r : std::vector<Renderer*>{&raster, &rt}) {
@@ -115,7 +117,8 @@ TEST_CASE("the key light's shadow falls where the geometry puts it, in both path
   }
 }
 
-TEST_CASE("a shell shows its front colour from the front and its back colour from behind", "[render]") {
+TEST_CASE("a shell shows its front colour from the front and its back colour from behind",
+          "[render]") {
   PreviewScene s;
   RenderMesh sheet = tessellate_square(Vec3d(0, 0, 0), Vec3d(0, 0, 1), 0.5, 4);
   sheet.kind = SurfaceKind::Shell;
@@ -132,13 +135,16 @@ TEST_CASE("a shell shows its front colour from the front and its back colour fro
       const Image im = r->render(s, camera_at(Vec3d(0, 0, 2 * side), Vec3d(0, 0, 0), 64, 48));
       const std::uint8_t* p = im.pixel(32, 24);
       CAPTURE(r->name(), side, int(p[0]), int(p[2]));
-      if (side > 0) CHECK(p[0] > p[2] + 50);
-      else CHECK(p[2] > p[0] + 50);
+      if (side > 0)
+        CHECK(p[0] > p[2] + 50);
+      else
+        CHECK(p[2] > p[0] + 50);
     }
   }
 }
 
-TEST_CASE("renders are deterministic: same scene, same pixels, whatever the thread count", "[render]") {
+TEST_CASE("renders are deterministic: same scene, same pixels, whatever the thread count",
+          "[render]") {
   PreviewScene s = mixed_scene();
   s.ao_samples = 2;
   const Camera cam = camera_at(Vec3d(0.5, 0.8, 3.0), Vec3d(0, 0, 0), 160, 120);

@@ -708,8 +708,9 @@ TEST_CASE("stress: a sheet pulled to 3x its length", "[stress]") {
         const shellmpm::ShellMaterialDesc& m = r.scene.shell_materials[0];
         const double k = 0.225 * m.youngs_modulus / (1 - m.poisson_ratio);
         const double over = std::max(3.0 - m.stretch_limit, 0.0);
-        const double uniaxial = m.thickness * rest_area(r, 0) *
-                                (0.5 * m.youngs_modulus * std::log(3.0) * std::log(3.0) + k * over * over);
+        const double uniaxial =
+            m.thickness * rest_area(r, 0) *
+            (0.5 * m.youngs_modulus * std::log(3.0) * std::log(3.0) + k * over * over);
         const double stored = r.frames.back()["shell_membrane_energy"].get<double>();
         INFO("membrane energy " << stored << " J, uniaxial estimate " << uniaxial << " J");
         CHECK(stored > 0.5 * uniaxial);

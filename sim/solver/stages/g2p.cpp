@@ -17,7 +17,8 @@ void G2pStage::run(StepContext& c) {
     };
   if (c.scene.shot.shell_guard) {
     c.shell_x_start.resize(c.grid_shells.size());
-    for (std::size_t s = 0; s < c.grid_shells.size(); ++s) c.shell_x_start[s] = c.grid_shells[s].shell->x;
+    for (std::size_t s = 0; s < c.grid_shells.size(); ++s)
+      c.shell_x_start[s] = c.grid_shells[s].shell->x;
   }
   const bool fields = c.shell_fields.active();
   if (fields)

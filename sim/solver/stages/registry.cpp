@@ -32,18 +32,25 @@ Entry entry() {
 // Execution order. Shell forces come first (the transfer carries them), the grid stages
 // in the order of one MPM step (the shell guard last, after G2P has moved the control
 // points and the colliders have projected points out: a projection after it moved
-// control points through the layers the guard had just held apart), then the shells' denting and the emission of new
-// particles for the next step.
+// control points through the layers the guard had just held apart), then the shells' denting and
+// the emission of new particles for the next step.
 const std::vector<Entry>& registry() {
   static const std::vector<Entry> table = {
-      entry<ShellForcesStage>(),   entry<ShellUpdateStage>(),
-      entry<ContactForcesStage>(), entry<BinStage>(),
-      entry<P2gStage>(),           entry<GridUpdateStage>(),
-      entry<ContactGridStage>(),   entry<CollidersStage>(),
-      entry<G2pStage>(),           entry<ColliderParticlesStage>(),
+      entry<ShellForcesStage>(),
+      entry<ShellUpdateStage>(),
+      entry<ContactForcesStage>(),
+      entry<BinStage>(),
+      entry<P2gStage>(),
+      entry<GridUpdateStage>(),
+      entry<ContactGridStage>(),
+      entry<CollidersStage>(),
+      entry<G2pStage>(),
+      entry<ColliderParticlesStage>(),
       entry<ShellGuardStage>(),
-      entry<FrictionStage>(),      entry<BulkPlasticityStage>(),
-      entry<DentingStage>(),       entry<EmitStage>(),
+      entry<FrictionStage>(),
+      entry<BulkPlasticityStage>(),
+      entry<DentingStage>(),
+      entry<EmitStage>(),
   };
   return table;
 }

@@ -36,7 +36,8 @@ struct Rig {
     cp.kc = 1e5;
     cp.gamma = 4e4;
     cp.friction = 0.3;
-    contact = std::make_unique<ShellContact>(shell->basis(), shell->rest, mat.thickness, samples, cp);
+    contact =
+        std::make_unique<ShellContact>(shell->basis(), shell->rest, mat.thickness, samples, cp);
     // Deform: small random displacement of the control points; compress and shear a3E.
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1, 1);
@@ -71,7 +72,8 @@ struct Rig {
     for (std::size_t b = 0; b < grid.num_particle_blocks(); ++b) {
       auto& buf = grid.pblock_buf[b];
       std::fill(buf.begin(), buf.end(), GridNode{0, {0, 0, 0}});
-      shell_p2g_block(grid, table, shells, Real(1), b, buf.data());  // dt = 1, v = 0: momentum = force
+      shell_p2g_block(grid, table, shells, Real(1), b,
+                      buf.data());  // dt = 1, v = 0: momentum = force
     }
     grid.gather_buffers_to_grid(true);
     std::map<std::uint64_t, Vec3d> tangential;
@@ -122,7 +124,8 @@ struct Rig {
           for (int k = 0; k < 3; ++k, ++n)
             if (st.base[0] + i == node[0] && st.base[1] + j == node[1] && st.base[2] + k == node[2])
               a3 += u * st.grad[n].cast<double>().dot(contact->a3e[s].cast<double>());
-      e += static_cast<double>(contact->volume[s]) * contact_gradient<double>(a1, a2, a3, p, nullptr);
+      e += static_cast<double>(contact->volume[s]) *
+           contact_gradient<double>(a1, a2, a3, p, nullptr);
     }
     return e;
   }

@@ -1,6 +1,6 @@
-// Contact elasticity and friction of one contact particle (sim/contact/contact_energy.h, friction_return_map.h):
-// finite differences of the energy against its gradient and Kirchhoff stress, and the
-// Coulomb return mapping.
+// Contact elasticity and friction of one contact particle (sim/contact/contact_energy.h,
+// friction_return_map.h): finite differences of the energy against its gradient and Kirchhoff
+// stress, and the Coulomb return mapping.
 #include <catch2/catch.hpp>
 #include <random>
 
@@ -55,8 +55,7 @@ double fd_error(const V3& a1, const V3& a2, const V3& a3, double eps) {
 
 }  // namespace
 
-TEST_CASE("contact energy gradient matches finite differences, error falls with eps",
-          "[contact]") {
+TEST_CASE("contact energy gradient matches finite differences, error falls with eps", "[contact]") {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 20; ++trial) {
     V3 a1, a2, a3;

@@ -246,7 +246,8 @@ TEST_CASE("cloth draped on a sphere penetrates it by less than half a cell", "[c
   for (int f = 2; f <= 24; ++f) {
     solver.advance_to((f - 1) / s.shot.fps);
     solver.shells()[0]->output_mesh(pos, n);
-    for (const Vec3& p : pos) min_r = std::min(min_r, (p.cast<double>() - ball.shape.center).norm());
+    for (const Vec3& p : pos)
+      min_r = std::min(min_r, (p.cast<double>() - ball.shape.center).norm());
   }
   INFO("closest approach to the centre " << min_r << " (radius 0.15, dx 0.025)");
   CHECK(min_r > 0.15 - 0.5 * s.shot.dx);
@@ -257,7 +258,8 @@ namespace {
 
 // Distance travelled down the slope by the centre of mass of shell `i`, sampled at the
 // given times. The slope descends along t = (cos th, -sin th, 0).
-std::vector<double> slide(Solver& solver, std::size_t i, double th, const std::vector<double>& times) {
+std::vector<double> slide(Solver& solver, std::size_t i, double th,
+                          const std::vector<double>& times) {
   const Vec3d t(std::cos(th), -std::sin(th), 0);
   std::vector<double> out;
   for (double tt : times) {
@@ -299,7 +301,8 @@ Scene incline_scene(double th_deg, bool on_sheet, double mu, double gap0 = 0.03,
     c.friction = mu;
     s.colliders.push_back(c);
   }
-  ShellDesc top = sheet("block", size, res, gap0 * n + Vec3d(-0.2 * std::cos(th), 0.2 * std::sin(th), 0));
+  ShellDesc top =
+      sheet("block", size, res, gap0 * n + Vec3d(-0.2 * std::cos(th), 0.2 * std::sin(th), 0));
   top.rotate_deg = Vec3d(0, 0, -th_deg);
   s.shells.push_back(top);
   return s;
@@ -326,8 +329,9 @@ Slide run_incline(double th_deg, bool on_sheet, double mu, double gap0, double s
 
 }  // namespace
 
-TEST_CASE("a sheet on an inclined collider obeys Coulomb's law (sticks, or slides at g (sin - mu cos))",
-          "[contact]") {
+TEST_CASE(
+    "a sheet on an inclined collider obeys Coulomb's law (sticks, or slides at g (sin - mu cos))",
+    "[contact]") {
   const double mu = 0.3;
   // 10 degrees: tan = 0.18 < mu, it sticks. 30 degrees: tan = 0.58 > mu, it slides.
   for (double th_deg : {10.0, 30.0}) {
@@ -346,8 +350,10 @@ TEST_CASE("a sheet on an inclined collider obeys Coulomb's law (sticks, or slide
   }
 }
 
-TEST_CASE("a sheet on a pinned inclined sheet obeys Coulomb's law (sticks, or slides at g (sin - c_F cos))",
-          "[contact][slow]") {
+TEST_CASE(
+    "a sheet on a pinned inclined sheet obeys Coulomb's law (sticks, or slides at g (sin - c_F "
+    "cos))",
+    "[contact][slow]") {
   // Coulomb between shells: friction comes only from the contact particles' return
   // mapping; the sheets share grid nodes but keep their own velocities there (ShellFields).
   const double mu = 0.3;

@@ -111,7 +111,8 @@ TEST_CASE("shell guard: two sheets driven through each other stop at the gap", "
       drive(sh, {Vec3(0, 2.5f, 0), Vec3(0.3f, -1.0f, 0)});
       if (!guarded) continue;
       std::vector<Vec3> x0a(sh[0]->size()), x0b(sh[1]->size());
-      for (std::size_t j = 0; j < sh[0]->size(); ++j) x0a[j] = sh[0]->x[j] - Real(kDt) * sh[0]->v[j];
+      for (std::size_t j = 0; j < sh[0]->size(); ++j)
+        x0a[j] = sh[0]->x[j] - Real(kDt) * sh[0]->v[j];
       const Totals before = totals(sh, nullptr, 0);
       const ShellGuardStats st = guard.apply(gs, GuardBulk{}, kDt);
       const Totals after = totals(sh, nullptr, 0);
@@ -152,8 +153,7 @@ TEST_CASE("shell guard: a pinned sheet holds and keeps its prescribed motion", "
   CHECK(mean_y(*sh[1]) > mean_y(*sh[0]));
 }
 
-TEST_CASE("shell guard: fast bulk particles stay on their side of a light sheet",
-          "[shell_guard]") {
+TEST_CASE("shell guard: fast bulk particles stay on their side of a light sheet", "[shell_guard]") {
   std::vector<std::unique_ptr<ShellObject>> sh;
   sh.push_back(sheet(0.2, 8, 0.0, 100));
   std::vector<GridShell> gs = grid_shells(sh);
@@ -228,8 +228,8 @@ TEST_CASE("shell guard: the candidate lists never change a result", "[shell_guar
 
 TEST_CASE("segment closest points", "[shell_guard]") {
   // Crossing at right angles, 1 apart.
-  Eigen::Vector2d st = closest_segment_params(Vec3d(-1, 0, 0), Vec3d(1, 0, 0), Vec3d(0.5, -1, 1),
-                                              Vec3d(0.5, 1, 1));
+  Eigen::Vector2d st =
+      closest_segment_params(Vec3d(-1, 0, 0), Vec3d(1, 0, 0), Vec3d(0.5, -1, 1), Vec3d(0.5, 1, 1));
   CHECK(st[0] == Approx(0.75));
   CHECK(st[1] == Approx(0.5));
   // Beyond an end: clamped.

@@ -42,16 +42,18 @@ void jitter(TestMesh& m, double amount, unsigned seed) {
 }
 
 TestMesh tetrahedron() {
-  TestMesh m{"tetrahedron", {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}},
+  TestMesh m{"tetrahedron",
+             {{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}},
              {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}}};
   jitter(m, 0.1, 1);
   return m;
 }
 
 TestMesh octahedron() {
-  TestMesh m{"octahedron",
-             {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
-             {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}}};
+  TestMesh m{
+      "octahedron",
+      {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+      {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}}};
   jitter(m, 0.1, 2);
   return m;
 }
@@ -59,11 +61,21 @@ TestMesh octahedron() {
 TestMesh icosahedron() {
   const double p = (1 + std::sqrt(5.0)) / 2;
   TestMesh m{"icosahedron",
-             {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0}, {0, -1, p}, {0, 1, p}, {0, -1, -p},
-              {0, 1, -p}, {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}},
-             {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-              {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-              {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}}};
+             {{-1, p, 0},
+              {1, p, 0},
+              {-1, -p, 0},
+              {1, -p, 0},
+              {0, -1, p},
+              {0, 1, p},
+              {0, -1, -p},
+              {0, 1, -p},
+              {p, 0, -1},
+              {p, 0, 1},
+              {-p, 0, -1},
+              {-p, 0, 1}},
+             {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+              {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+              {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}}};
   jitter(m, 0.1, 3);
   return m;
 }
@@ -104,7 +116,8 @@ TestMesh disc(int k, int rings, unsigned seed) {
   for (int r = 1; r < rings; ++r)
     for (int s = 0; s < k; ++s) {
       for (int a = 0; a <= r; ++a)
-        m.t.emplace_back(id(r, s * r + a), id(r + 1, s * (r + 1) + a), id(r + 1, s * (r + 1) + a + 1));
+        m.t.emplace_back(id(r, s * r + a), id(r + 1, s * (r + 1) + a),
+                         id(r + 1, s * (r + 1) + a + 1));
       for (int a = 0; a < r; ++a)
         m.t.emplace_back(id(r, s * r + a), id(r + 1, s * (r + 1) + a + 1), id(r, s * r + a + 1));
     }
@@ -130,16 +143,16 @@ TestMesh grid(int nx, int ny, double jit, unsigned seed) {
 }
 
 std::vector<TestMesh> all_meshes() {
-  return {tetrahedron(), octahedron(), icosahedron(), bipyramid(8), bipyramid(12),
-          disc(3, 3, 11),  disc(4, 3, 12), disc(5, 3, 13), disc(7, 3, 14), disc(8, 3, 15),
-          disc(12, 3, 16), grid(5, 4, 0.1, 17)};
+  return {tetrahedron(),  octahedron(),   icosahedron(),   bipyramid(8),
+          bipyramid(12),  disc(3, 3, 11), disc(4, 3, 12),  disc(5, 3, 13),
+          disc(7, 3, 14), disc(8, 3, 15), disc(12, 3, 16), grid(5, 4, 0.1, 17)};
 }
 
 /// Points per face: interior, on edges, at corners, plus random ones.
 std::vector<Eigen::Vector2d> sample_points(unsigned seed, int nrandom) {
-  std::vector<Eigen::Vector2d> p = {{1.0 / 3, 1.0 / 3}, {0.1, 0.2}, {0.7, 0.1},  {0.05, 0.9},
-                                    {0.5, 0.5},         {0.25, 0},  {0, 0.6},    {0.3, 0.3},
-                                    {0, 0},             {1, 0},     {0, 1},      {0.02, 0.01}};
+  std::vector<Eigen::Vector2d> p = {
+      {1.0 / 3, 1.0 / 3}, {0.1, 0.2}, {0.7, 0.1}, {0.05, 0.9}, {0.5, 0.5}, {0.25, 0},
+      {0, 0.6},           {0.3, 0.3}, {0, 0},     {1, 0},      {0, 1},     {0.02, 0.01}};
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   for (int i = 0; i < nrandom; ++i) {
@@ -269,7 +282,8 @@ double distance_to_irregular_corner(const TestMesh& m, int face, double s, doubl
       ++nfaces[tr[k]];
       for (int q = 1; q < 3; ++q) {
         auto& nb = nbr[tr[k]];
-        if (std::find(nb.begin(), nb.end(), tr[(k + q) % 3]) == nb.end()) nb.push_back(tr[(k + q) % 3]);
+        if (std::find(nb.begin(), nb.end(), tr[(k + q) % 3]) == nb.end())
+          nb.push_back(tr[(k + q) % 3]);
       }
     }
   const double cxy[3][2] = {{0, 0}, {1, 0}, {0, 1}};
@@ -283,7 +297,9 @@ double distance_to_irregular_corner(const TestMesh& m, int face, double s, doubl
   return best;
 }
 
-bool verbose() { return std::getenv("SHELLMPM_TEST_VERBOSE") != nullptr; }
+bool verbose() {
+  return std::getenv("SHELLMPM_TEST_VERBOSE") != nullptr;
+}
 
 }  // namespace
 
@@ -311,10 +327,11 @@ TEST_CASE("Loop basis matches OpenSubdiv limit surface and derivatives", "[loop]
         }
       }
     if (verbose())
-      std::printf("%-12s regular: pos %.2e d1 %.2e d2 %.2e | irregular (>0.01): pos %.2e d1 %.2e "
-                  "d2 %.2e | near EV pos %.2e\n",
-                  m.name.c_str(), err_reg[0], err_reg[1], err_reg[2], err_irr[0], err_irr[1],
-                  err_irr[2], err_near);
+      std::printf(
+          "%-12s regular: pos %.2e d1 %.2e d2 %.2e | irregular (>0.01): pos %.2e d1 %.2e "
+          "d2 %.2e | near EV pos %.2e\n",
+          m.name.c_str(), err_reg[0], err_reg[1], err_reg[2], err_irr[0], err_irr[1], err_irr[2],
+          err_near);
     INFO(m.name);
     CHECK(err_reg[0] < 1e-12);
     CHECK(err_reg[1] < 1e-11);
@@ -382,8 +399,7 @@ TEST_CASE("Loop basis: partition of unity everywhere", "[loop]") {
   }
 }
 
-TEST_CASE("Loop basis reproduces linear fields on a regular lattice, boundary included",
-          "[loop]") {
+TEST_CASE("Loop basis reproduces linear fields on a regular lattice, boundary included", "[loop]") {
   // Control points on an affine image of the lattice: the limit is the same affine map
   // of the parameter on every face whose corners are regular (interior or boundary).
   TestMesh m = grid(6, 5, 0.0, 0);

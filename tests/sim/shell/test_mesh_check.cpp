@@ -46,8 +46,10 @@ TEST_CASE("mesh check: good meshes have no problems and LoopBasis accepts them",
   REQUIRE(check_shell_mesh(x, t).empty());
   REQUIRE_NOTHROW(LoopBasis(static_cast<int>(x.size()), t));
   // Closed octahedron.
-  const std::vector<Vec3d> ox = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  const Tris ot = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  const std::vector<Vec3d> ox = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                 {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  const Tris ot = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                   {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   REQUIRE(check_shell_mesh(ox, ot).empty());
 }
 

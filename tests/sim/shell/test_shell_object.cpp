@@ -217,8 +217,8 @@ TEST_CASE("meshes with valence 3 to 12 and open boundaries run without NaN", "[s
         REQUIRE(std::isfinite(o.x[i].norm()));
         pe += o.mass[i] * 9.81 * o.x[i].y();
       }
-      emax = std::max(emax, fs.shell_kinetic_energy + fs.shell_membrane_energy +
-                                fs.shell_bending_energy + pe);
+      emax = std::max(
+          emax, fs.shell_kinetic_energy + fs.shell_membrane_energy + fs.shell_bending_energy + pe);
     }
     INFO("valence " << k);
     REQUIRE(emax < 1e-3);  // starts at 0 total energy; nothing is created

@@ -131,8 +131,8 @@ TEST_CASE("a sand column collapses and comes to rest with no particle lost", "[s
   ground.boundary = BoundaryKind::Sticky;
   s.colliders.push_back(ground);
   Solver solver(s);
-  REQUIRE(solver.stage_names() ==
-          std::vector<std::string>{"bin", "p2g", "grid", "colliders", "g2p", "collider_particles", "plasticity"});
+  REQUIRE(solver.stage_names() == std::vector<std::string>{"bin", "p2g", "grid", "colliders", "g2p",
+                                                           "collider_particles", "plasticity"});
   const std::size_t n0 = solver.particles().size();
   FrameStats fs0;
   solver.measure(fs0);
@@ -150,8 +150,8 @@ TEST_CASE("a sand column collapses and comes to rest with no particle lost", "[s
     ymax = std::max(ymax, double(x.y()));
     rmax = std::max(rmax, std::hypot(double(x.x()), double(x.z())));
   }
-  REQUIRE(ymax < 0.26);   // the column (0.30 tall) has slumped
-  REQUIRE(rmax > 0.12);   // and spread beyond its initial half-width (0.085 diagonal)
+  REQUIRE(ymax < 0.26);          // the column (0.30 tall) has slumped
+  REQUIRE(rmax > 0.12);          // and spread beyond its initial half-width (0.085 diagonal)
   REQUIRE(fs.max_speed < 0.05);  // at rest
   REQUIRE(fs.kinetic_energy < 1e-4 * fs0.mass * 9.81 * 0.3);
 }

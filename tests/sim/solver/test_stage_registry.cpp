@@ -126,8 +126,7 @@ TEST_CASE("every registered stage is reachable, once, in one execution order", "
   const Names all = stages_of(s);
   REQUIRE(all == Names{"shell_forces", "shell_update", "contact", "bin", "p2g", "grid",
                        "contact_grid", "colliders", "g2p", "collider_particles", "shell_guard",
-                       "friction",
-                       "plasticity", "denting", "emit"});
+                       "friction", "plasticity", "denting", "emit"});
   REQUIRE(std::set<std::string>(all.begin(), all.end()).size() == all.size());
   // And nothing to simulate: no stage at all.
   REQUIRE(stages_of(base_scene()).empty());

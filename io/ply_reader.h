@@ -10,8 +10,8 @@ namespace shellmpm {
 
 struct PlyMesh {
   std::vector<Vec3f> positions;
-  std::vector<Vec3f> normals;               ///< empty unless the file has nx, ny, nz
-  std::vector<Eigen::Vector3i> triangles;   ///< empty for point clouds
+  std::vector<Vec3f> normals;              ///< empty unless the file has nx, ny, nz
+  std::vector<Eigen::Vector3i> triangles;  ///< empty for point clouds
 };
 
 /// Reads vertices (x, y, z and, when present, nx, ny, nz) and triangle faces.
