@@ -8,6 +8,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <vector>
+#include "sim/scene/scene_words.h"
 
 #include "io/atomic_file.h"
 #include "sim/core/check.h"
@@ -18,9 +19,7 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
 namespace shellmpm {
 
 MeshFormat parse_mesh_format(const std::string& name) {
-  if (name == "ply") return MeshFormat::Ply;
-  if (name == "obj") return MeshFormat::Obj;
-  if (name == "glb") return MeshFormat::Glb;
+  if (const std::optional<MeshFormat> f = enum_of_word<MeshFormat>(name)) return *f;
   throw std::invalid_argument("unknown mesh format '" + name + "' (expected ply, obj or glb)");
 }
 
@@ -233,12 +232,10 @@ std::string json_float(float x) {
   return s;
 }
 
-std::string encode_glb(const MeshFrame& m, const Attributes& a) {
-  const std::size_t n = m.num_vertices, nt = m.num_triangles;
+/// The BIN chunk: positions, normals, [uvs], [velocities], indices; every block is a
+/// multiple of 4 bytes. `index_offset` gets where the indices start.
+std::string glb_bin(const Attributes& a, std::size_t n, std::size_t nt, std::size_t& index_offset) {
   const bool uv = !a.uvs.empty(), vel = !a.velocities.empty();
-
-  // BIN chunk: positions, normals, [uvs], [velocities], indices; every block is a
-  // multiple of 4 bytes.
   std::string bin;
   bin.reserve(n * (24 + (uv ? 8 : 0) + (vel ? 12 : 0)) + nt * 12);
   append_raw(bin, a.positions.data(), a.positions.size());
@@ -249,9 +246,16 @@ std::string encode_glb(const MeshFrame& m, const Attributes& a) {
     append_raw(bin, flipped.data(), flipped.size());
   }
   if (vel) append_raw(bin, a.velocities.data(), a.velocities.size());
-  const std::size_t index_offset = bin.size();
+  index_offset = bin.size();
   append_raw(bin, a.indices.data(), a.indices.size());
+  return bin;
+}
 
+/// The bufferViews and accessors, one per attribute, in the BIN order; POSITION carries
+/// its bounds.
+std::string glb_views_and_accessors(const Attributes& a, std::size_t n, std::size_t nt,
+                                    std::size_t index_offset) {
+  const bool uv = !a.uvs.empty(), vel = !a.velocities.empty();
   float lo[3], hi[3];
   for (int k = 0; k < 3; ++k) lo[k] = hi[k] = a.positions[k];
   for (std::size_t v = 0; v < n; ++v)
@@ -259,21 +263,6 @@ std::string encode_glb(const MeshFrame& m, const Attributes& a) {
       lo[k] = std::min(lo[k], a.positions[3 * v + k]);
       hi[k] = std::max(hi[k], a.positions[3 * v + k]);
     }
-
-  const std::string name = json_string(m.name.empty() ? "shell" : m.name);
-  std::string j = "{\"asset\":{\"version\":\"2.0\",\"generator\":\"shellmpm\"},";
-  j += "\"scene\":0,\"scenes\":[{\"nodes\":[0],\"extras\":{\"frame\":" + std::to_string(m.frame) +
-       ",\"time\":" + format_double(m.time) + "}}],";
-  j += "\"nodes\":[{\"name\":" + name + ",\"mesh\":0}],";
-  j += "\"meshes\":[{\"name\":" + name + ",\"primitives\":[{\"attributes\":{";
-  // Accessors in BIN order: POSITION, NORMAL, [TEXCOORD_0], [_VELOCITY], indices.
-  int accessor = 2;
-  j += "\"POSITION\":0,\"NORMAL\":1";
-  if (uv) j += ",\"TEXCOORD_0\":" + std::to_string(accessor++);
-  if (vel) j += ",\"_VELOCITY\":" + std::to_string(accessor++);
-  j += "},\"indices\":" + std::to_string(accessor) + ",\"mode\":4}]}],";
-  j += "\"buffers\":[{\"byteLength\":" + std::to_string(bin.size()) + "}],";
-  // bufferViews and accessors, one per attribute, in the BIN order above.
   std::string views = "\"bufferViews\":[", accessors = "\"accessors\":[";
   std::size_t offset = 0;
   int view = 0;
@@ -303,7 +292,29 @@ std::string encode_glb(const MeshFrame& m, const Attributes& a) {
   if (vel) add(12 * n, kArrayBuffer, kFloat, n, "VEC3", "");
   SHELLMPM_CHECK(offset == index_offset, "offset " << offset << " vs " << index_offset);
   add(12 * nt, kElementArrayBuffer, kUnsignedInt, 3 * nt, "SCALAR", "");
-  j += views + "]," + accessors + "]}";
+  return views + "]," + accessors + "]";
+}
+
+std::string encode_glb(const MeshFrame& m, const Attributes& a) {
+  const std::size_t n = m.num_vertices, nt = m.num_triangles;
+  const bool uv = !a.uvs.empty(), vel = !a.velocities.empty();
+  std::size_t index_offset = 0;
+  const std::string bin = glb_bin(a, n, nt, index_offset);
+
+  const std::string name = json_string(m.name.empty() ? "shell" : m.name);
+  std::string j = "{\"asset\":{\"version\":\"2.0\",\"generator\":\"shellmpm\"},";
+  j += "\"scene\":0,\"scenes\":[{\"nodes\":[0],\"extras\":{\"frame\":" + std::to_string(m.frame) +
+       ",\"time\":" + format_double(m.time) + "}}],";
+  j += "\"nodes\":[{\"name\":" + name + ",\"mesh\":0}],";
+  j += "\"meshes\":[{\"name\":" + name + ",\"primitives\":[{\"attributes\":{";
+  // Accessors in BIN order: POSITION, NORMAL, [TEXCOORD_0], [_VELOCITY], indices.
+  int accessor = 2;
+  j += "\"POSITION\":0,\"NORMAL\":1";
+  if (uv) j += ",\"TEXCOORD_0\":" + std::to_string(accessor++);
+  if (vel) j += ",\"_VELOCITY\":" + std::to_string(accessor++);
+  j += "},\"indices\":" + std::to_string(accessor) + ",\"mode\":4}]}],";
+  j += "\"buffers\":[{\"byteLength\":" + std::to_string(bin.size()) + "}],";
+  j += glb_views_and_accessors(a, n, nt, index_offset) + "}";
   while (j.size() % 4) j += ' ';  // the JSON chunk is padded with spaces
 
   const auto u32 = [](std::string& out, std::uint32_t x) { append_raw(out, &x, 1); };

@@ -32,7 +32,8 @@ float hash01(std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d)
 }
 
 /// Slab test of a ray against an axis-aligned box: [t0, t1], empty when t0 > t1.
-bool ray_box(const Vec3f& o, const Vec3f& d, const Vec3f& lo, const Vec3f& hi, float& t0, float& t1) {
+bool ray_box(const Vec3f& o, const Vec3f& d, const Vec3f& lo, const Vec3f& hi, float& t0,
+             float& t1) {
   t0 = 0.0f;
   t1 = kInf;
   for (int a = 0; a < 3; ++a) {
@@ -49,7 +50,7 @@ bool ray_box(const Vec3f& o, const Vec3f& d, const Vec3f& lo, const Vec3f& hi, f
 /// the camera (precomputed per voxel, so the march only interpolates).
 struct VolumeField {
   const RenderVolume* v = nullptr;
-  std::vector<Vec3f> radiance;  ///< per voxel: albedo * incident light (key, fill, sky)
+  std::vector<Vec3f> radiance;     ///< per voxel: albedo * incident light (key, fill, sky)
   Vec3f lo{0, 0, 0}, hi{0, 0, 0};  ///< box of the samples
 
   bool empty() const { return v == nullptr || v->empty(); }
@@ -166,15 +167,17 @@ struct Tracer {
             const float sky = std::exp(-(above + 0.5f * d) * h * ext);
             above += d;
             if (!near) continue;
-            const Vec3f p = v.origin + Vec3f(static_cast<float>(i), static_cast<float>(j),
-                                             static_cast<float>(k)) * h;
+            const Vec3f p =
+                v.origin +
+                Vec3f(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)) * h;
             auto dens = [&](int a, int b, int c) {
               a = std::clamp(a, 0, nx - 1);
               b = std::clamp(b, 0, ny - 1);
               c = std::clamp(c, 0, nz - 1);
               return v.at(a, b, c);
             };
-            const Vec3f grad(dens(i + 1, j, k) - dens(i - 1, j, k), dens(i, j + 1, k) - dens(i, j - 1, k),
+            const Vec3f grad(dens(i + 1, j, k) - dens(i - 1, j, k),
+                             dens(i, j + 1, k) - dens(i, j - 1, k),
                              dens(i, j, k + 1) - dens(i, j, k - 1));
             const float g = grad.norm();
             const Vec3f n = g > 0.0f ? Vec3f(-grad / g) : Vec3f(0, 1, 0);
@@ -182,10 +185,12 @@ struct Tracer {
             auto lambert = [&](const Vec3f& l) {
               return (1.0f - wgt) * 0.5f + wgt * std::max(0.0f, n.dot(l));
             };
-            float t_key = vol.transmittance(p + 0.5f * h * key_dir, key_dir) * std::exp(-0.5f * d * h * ext);
+            float t_key =
+                vol.transmittance(p + 0.5f * h * key_dir, key_dir) * std::exp(-0.5f * d * h * ext);
             if (t_key > 0.0f && occluded(p, key_dir, kInf)) t_key = 0.0f;
-            const float light = L.key * t_key * lambert(key_dir) + L.fill * lambert(fill_dir) +
-                                L.ambient * sky * (0.55f + 0.45f * ((1.0f - wgt) * 0.5f + wgt * n.y()));
+            const float light =
+                L.key * t_key * lambert(key_dir) + L.fill * lambert(fill_dir) +
+                L.ambient * sky * (0.55f + 0.45f * ((1.0f - wgt) * 0.5f + wgt * n.y()));
             vol.radiance[idx] = v.color * light;
           }
         }
@@ -214,27 +219,31 @@ struct Tracer {
       const bool front = ng.dot(dir) < 0.0f;
       albedo = front ? m.front : m.back;
       const float u = rh.hit.u, w = rh.hit.v;
-      n = m.normals.empty() ? ng
-                            : Vec3f((1 - u - w) * m.normals[t[0]] + u * m.normals[t[1]] +
-                                    w * m.normals[t[2]]).normalized();
+      n = m.normals.empty()
+              ? ng
+              : Vec3f((1 - u - w) * m.normals[t[0]] + u * m.normals[t[1]] + w * m.normals[t[2]])
+                    .normalized();
       if (n.dot(dir) > 0.0f) n = -n;
       if (!front) ng = -ng;
       if (kind == SurfaceKind::Ground) albedo = ground_albedo(scene.ground, albedo, p);
     }
     const Vec3f o = p + eps * ng;
     float shadow = 0.0f;
-    if (ng.dot(key_dir) > 0.0f && !occluded(o, key_dir, kInf)) shadow = vol.transmittance(o, key_dir);
+    if (ng.dot(key_dir) > 0.0f && !occluded(o, key_dir, kInf))
+      shadow = vol.transmittance(o, key_dir);
     float ao = 1.0f;
     if (scene.ao_samples > 0) {
       // Cosine-weighted directions around n, from the hash.
-      const Vec3f t1 = (std::abs(n.x()) > 0.9f ? Vec3f(0, 1, 0) : Vec3f(1, 0, 0)).cross(n).normalized();
+      const Vec3f t1 =
+          (std::abs(n.x()) > 0.9f ? Vec3f(0, 1, 0) : Vec3f(1, 0, 0)).cross(n).normalized();
       const Vec3f t2 = n.cross(t1);
       int hits = 0;
       for (int k = 0; k < scene.ao_samples; ++k) {
         const float r1 = hash01(px, py, s, 2u * k + 11u), r2 = hash01(px, py, s, 2u * k + 12u);
         const float r = std::sqrt(r1), phi = 6.2831853f * r2;
         const Vec3f d = (r * std::cos(phi) * t1 + r * std::sin(phi) * t2 +
-                         std::sqrt(std::max(0.0f, 1.0f - r1)) * n).normalized();
+                         std::sqrt(std::max(0.0f, 1.0f - r1)) * n)
+                            .normalized();
         if (d.dot(ng) <= 0.0f || occluded(o, d, scene.ao_distance)) ++hits;
       }
       ao = 1.0f - static_cast<float>(hits) / static_cast<float>(scene.ao_samples);
@@ -320,19 +329,18 @@ RayTracer::~RayTracer() {
   if (device_) rtcReleaseDevice(device_);
 }
 
-Image RayTracer::render(const PreviewScene& scene, const Camera& cam) {
-  Tracer tr(scene, cam);
-  device_error_text().clear();
-  tr.rtc = rtcNewScene(device_);
-  rtcSetSceneFlags(tr.rtc, RTC_SCENE_FLAG_ROBUST);
+namespace {
+
+/// Attaches every non-empty mesh of the scene to tr.rtc as triangles.
+void attach_meshes(RTCDevice device, Tracer& tr, const PreviewScene& scene) {
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const RenderMesh& m = scene.meshes[i];
     if (m.triangles.empty()) continue;
-    RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                           3 * sizeof(float), m.positions.size()));
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                              3 * sizeof(unsigned), m.triangles.size()));
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.positions.size()));
+    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.triangles.size()));
     if (!vb || !ib) {
       rtcReleaseGeometry(g);
       rtcReleaseScene(tr.rtc);
@@ -348,39 +356,36 @@ Image RayTracer::render(const PreviewScene& scene, const Camera& cam) {
     if (tr.mesh_of_geom.size() <= id) tr.mesh_of_geom.resize(id + 1, -1);
     tr.mesh_of_geom[id] = static_cast<int>(i);
   }
-  if (!scene.particles.positions.empty()) {
-    const RenderParticles& p = scene.particles;
-    RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                           4 * sizeof(float), p.positions.size()));
-    if (!vb) {
-      rtcReleaseGeometry(g);
-      rtcReleaseScene(tr.rtc);
-      throw std::runtime_error("ray tracer: out of memory for the particles");
-    }
-    for (std::size_t v = 0; v < p.positions.size(); ++v) {
-      vb[4 * v] = p.positions[v].x();
-      vb[4 * v + 1] = p.positions[v].y();
-      vb[4 * v + 2] = p.positions[v].z();
-      vb[4 * v + 3] = p.radius;
-    }
-    rtcCommitGeometry(g);
-    const unsigned id = rtcAttachGeometry(tr.rtc, g);
-    rtcReleaseGeometry(g);
-    if (tr.mesh_of_geom.size() <= id) tr.mesh_of_geom.resize(id + 1, -1);
-    tr.mesh_of_geom[id] = -1;
-  }
-  rtcCommitScene(tr.rtc);
-  if (!device_error_text().empty()) {
-    rtcReleaseScene(tr.rtc);
-    throw std::runtime_error("ray tracer: Embree: " + device_error_text());
-  }
-  const float size = std::max((scene.bounds_hi - scene.bounds_lo).norm(), 1e-3f);
-  tr.eps = 2e-5f * (size + static_cast<float>(cam.eye.norm()));
-  tr.key_dir = scene.lights.key_dir.normalized();
-  tr.fill_dir = scene.lights.fill_dir.normalized();
-  tr.prepare_volume();
+}
 
+/// Attaches the particles to tr.rtc as spheres of their radius.
+void attach_particles(RTCDevice device, Tracer& tr, const PreviewScene& scene) {
+  if (scene.particles.positions.empty()) return;
+  const RenderParticles& p = scene.particles;
+  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+      g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), p.positions.size()));
+  if (!vb) {
+    rtcReleaseGeometry(g);
+    rtcReleaseScene(tr.rtc);
+    throw std::runtime_error("ray tracer: out of memory for the particles");
+  }
+  for (std::size_t v = 0; v < p.positions.size(); ++v) {
+    vb[4 * v] = p.positions[v].x();
+    vb[4 * v + 1] = p.positions[v].y();
+    vb[4 * v + 2] = p.positions[v].z();
+    vb[4 * v + 3] = p.radius;
+  }
+  rtcCommitGeometry(g);
+  const unsigned id = rtcAttachGeometry(tr.rtc, g);
+  rtcReleaseGeometry(g);
+  if (tr.mesh_of_geom.size() <= id) tr.mesh_of_geom.resize(id + 1, -1);
+  tr.mesh_of_geom[id] = -1;
+}
+
+/// Traces every pixel, 16x16 tiles in parallel; each pixel averages its stratified,
+/// jittered samples (the jitter hashes the pixel and sample: the same on any thread count).
+Image trace_image(Tracer& tr, const PreviewScene& scene, const Camera& cam) {
   Image out(cam.width, cam.height);
   const int spp = std::max(1, scene.samples);
   const int m = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(spp))));
@@ -408,11 +413,37 @@ Image RayTracer::render(const PreviewScene& scene, const Camera& cam) {
           }
           std::uint8_t* px = out.pixel(x, y);
           for (int k = 0; k < 3; ++k)
-            px[k] = static_cast<std::uint8_t>(std::lround(std::clamp(sum[k] / spp, 0.0f, 1.0f) * 255.0f));
-          px[3] = static_cast<std::uint8_t>(std::lround(std::clamp(asum / spp, 0.0f, 1.0f) * 255.0f));
+            px[k] = static_cast<std::uint8_t>(
+                std::lround(std::clamp(sum[k] / spp, 0.0f, 1.0f) * 255.0f));
+          px[3] =
+              static_cast<std::uint8_t>(std::lround(std::clamp(asum / spp, 0.0f, 1.0f) * 255.0f));
         }
     }
   });
+  return out;
+}
+
+}  // namespace
+
+Image RayTracer::render(const PreviewScene& scene, const Camera& cam) {
+  Tracer tr(scene, cam);
+  device_error_text().clear();
+  tr.rtc = rtcNewScene(device_);
+  rtcSetSceneFlags(tr.rtc, RTC_SCENE_FLAG_ROBUST);
+  attach_meshes(device_, tr, scene);
+  attach_particles(device_, tr, scene);
+  rtcCommitScene(tr.rtc);
+  if (!device_error_text().empty()) {
+    rtcReleaseScene(tr.rtc);
+    throw std::runtime_error("ray tracer: Embree: " + device_error_text());
+  }
+  const float size = std::max((scene.bounds_hi - scene.bounds_lo).norm(), 1e-3f);
+  tr.eps = 2e-5f * (size + static_cast<float>(cam.eye.norm()));
+  tr.key_dir = scene.lights.key_dir.normalized();
+  tr.fill_dir = scene.lights.fill_dir.normalized();
+  tr.prepare_volume();
+
+  Image out = trace_image(tr, scene, cam);
   rtcReleaseScene(tr.rtc);
   return out;
 }

@@ -26,34 +26,34 @@ class SceneAssembler {
   /// @param framing_frame the frame whose shells the automatic camera frames (with the
   ///                      sources and colliders); when its files cannot be read, shells
   ///                      are left out of the framing
-  /// @throws UserError when the render settings ask for what the run did not write (e.g.
-  ///         bulk: particles without a particle cache) or the camera is unknown; mesh
-  ///         collider files that cannot be read (naming them).
+  /// @throws UserError for mesh collider files that cannot be read (naming them). Render
+  ///         settings that ask for what the run did not write (bulk: particles without a
+  ///         particle cache) or name an unknown camera are refused by the scene reader.
   SceneAssembler(const Scene& scene, std::string outdir, int framing_frame);
 
   /// The frame's scene. @throws CacheError naming the first file that is missing or corrupt.
   PreviewScene assemble(int frame) const;
 
   const Camera& camera() const { return camera_; }
-  /// What the bulk material is drawn as: "volume", "surface", "particles" or "none".
-  const std::string& bulk() const { return bulk_; }
+  /// What the bulk material is drawn as: Volume, Surface, Particles or None (never Auto).
+  BulkDraw bulk() const { return bulk_; }
   /// The cache files frame `frame` reads.
   std::vector<std::string> files(int frame) const;
 
  private:
   struct ColliderMesh {
-    RenderMesh local;              ///< in the collider's own frame
+    RenderMesh local;  ///< in the collider's own frame
     std::vector<Keyframe> keys;
   };
   const Scene& scene_;
   std::string outdir_;
-  std::string bulk_;
+  BulkDraw bulk_ = BulkDraw::None;
   Camera camera_;
   std::vector<ColliderMesh> colliders_;
   Vec3d frame_lo_, frame_hi_;  ///< the box the auto camera and the ground are laid out on
   bool has_ground_ = false;
   Vec3d ground_point_{0, 0, 0}, ground_normal_{0, 1, 0};
-  int ground_collider_ = -1;   ///< index of the plane collider used as ground, -1: synthetic
+  int ground_collider_ = -1;  ///< index of the plane collider used as ground, -1: synthetic
   Vec3f bulk_color_{0.5f, 0.5f, 0.5f};
   float particle_radius_ = 0.01f;
 

@@ -34,10 +34,10 @@
 #pragma once
 #include <array>
 #include <cmath>
-#include <cstring>
-#include <limits>
 #include <cstdint>
+#include <cstring>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "sim/contact/shell_transfer.h"
@@ -122,8 +122,8 @@ class ShellFields {
   struct FoldBlock {
     std::array<std::uint8_t, kBlockNodes> split;  ///< 1: the node has two classes
     std::array<Real, kBlockNodes> cut;            ///< class 1: fold_height >= cut
-    std::array<Node, kBlockNodes> second;  ///< class 1
-    std::array<Vec3, kBlockNodes> r;       ///< its velocity relative to the node
+    std::array<Node, kBlockNodes> second;         ///< class 1
+    std::array<Vec3, kBlockNodes> r;              ///< its velocity relative to the node
   };
   /// The height of node offset (i, j, k) over the tangent plane of a control point with
   /// unit normal n at grid coordinate fx within its stencil, in cells, along n turned to
@@ -138,23 +138,23 @@ class ShellFields {
     SparseGrid grid;  ///< binning of this shell's control points (its nodes unused)
     std::vector<std::array<Node, kPadNodes>> buf;
     std::vector<std::array<Node, kBlockNodes>> nodes;  ///< the shell, or its first class
-    std::vector<std::array<Vec3, kBlockNodes>> r;  ///< velocity relative to the node
-    std::vector<Vec3> x0;                          ///< control points at p2g time
-    std::vector<Vec3> normal;                      ///< control-point unit normals
-    std::vector<int> fold;           ///< per grid block: index into folds, -1: no fold
-    std::vector<FoldBlock> folds;    ///< grid blocks where the shell folds, in block order
-    std::vector<int> touched;        ///< per particle block: index into the fold buffers
+    std::vector<std::array<Vec3, kBlockNodes>> r;      ///< velocity relative to the node
+    std::vector<Vec3> x0;                              ///< control points at p2g time
+    std::vector<Vec3> normal;                          ///< control-point unit normals
+    std::vector<int> fold;         ///< per grid block: index into folds, -1: no fold
+    std::vector<FoldBlock> folds;  ///< grid blocks where the shell folds, in block order
+    std::vector<int> touched;      ///< per particle block: index into the fold buffers
     std::vector<std::array<Classes, kPadNodes>> class_buf;
   };
   /// One control point's share of its 27 stencil nodes in a field's P2G.
   struct PointShare {
     bool heights;  ///< keep the nodes' height range (fold fields on)
     Real m, mh;    ///< mass; its fully pinned part
-    Real align;  ///< +1 or -1: n turned to kAlign's side
+    Real align;    ///< +1 or -1: n turned to kAlign's side
     Vec3 fx, base, n;
     Mat3 A;
-    PointShare(const GridShell& gs, const Vec3& n, const Vec3& fx, std::uint32_t j, Real dx, Real dt,
-               bool with_heights);
+    PointShare(const GridShell& gs, const Vec3& n, const Vec3& fx, std::uint32_t j, Real dx,
+               Real dt, bool with_heights);
     /// Adds the weight-w share at stencil offset (i, j, k) to d.
     void add(Node& d, Real w, int i, int j, int k) const;
   };
@@ -162,6 +162,12 @@ class ShellFields {
   /// Between the sums and their normalisation in shell_p2g: finds the nodes where F's
   /// shell folds and splits its control points there into two classes (shell_folds.cpp).
   void split_folds(Field& F, const GridShell& gs, Real dt, bool serial);
+  /// split_folds' steps: the nodes whose heights spread (F.fold, F.folds with their cuts);
+  /// both classes scattered from the particle blocks next to split nodes (F.touched,
+  /// F.class_buf); their sums gathered into F.nodes and the second fields.
+  static void mark_split_nodes(Field& F);
+  void scatter_classes(Field& F, const GridShell& gs, Real dt, bool serial);
+  static void gather_classes(Field& F, bool serial);
   /// Bulk mass centroids on the grid blocks where shells have fields.
   void bulk_moments(const SparseGrid& combined, const ParticleSet& bulk, std::uint32_t first_bulk,
                     bool serial);
@@ -174,7 +180,7 @@ class ShellFields {
   std::vector<int> fblock_;
   std::vector<std::array<Vec3, kBlockNodes>> r_bulk_;
   std::vector<char> fielded_;  ///< per combined grid block: a shell field is present
-  std::vector<std::array<Moment, kPadNodes>> bulk_buf_;   ///< per combined particle block
+  std::vector<std::array<Moment, kPadNodes>> bulk_buf_;    ///< per combined particle block
   std::vector<std::array<Moment, kBlockNodes>> bulk_mom_;  ///< per combined grid block
   std::vector<std::uint64_t> shared_;
 };

@@ -20,7 +20,7 @@
 
 #include "sim/contact/shell_fields.h"
 #include "sim/core/parallel.h"
-#include "sim/mpm/bspline.h"
+#include "sim/mpm/apic_stencil.h"
 
 namespace shellmpm {
 namespace {
@@ -30,14 +30,10 @@ namespace {
 constexpr Real kMinRange = Real(1.0);
 }  // namespace
 
-void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool serial) {
-  const SparseGrid& G = F.grid;
-  const ShellObject& sh = *gs.shell;
-  const std::size_t ng = G.num_grid_blocks(), nb = G.num_particle_blocks();
-  const Real dx = static_cast<Real>(G.dx());
+void ShellFields::mark_split_nodes(Field& F) {
+  const std::size_t ng = F.grid.num_grid_blocks();
   F.fold.assign(ng, -1);
   F.folds.clear();
-  // 1. The nodes whose heights spread: cut at the midpoint.
   for (std::size_t g = 0; g < ng; ++g) {
     const auto& nodes = F.nodes[g];
     for (int n = 0; n < kBlockNodes; ++n) {
@@ -55,7 +51,13 @@ void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool seria
       F.folds[F.fold[g]].cut[n] = Real(0.5) * (d.hmin + d.hmax);
     }
   }
-  if (F.folds.empty()) return;
+}
+
+void ShellFields::scatter_classes(Field& F, const GridShell& gs, Real dt, bool serial) {
+  const SparseGrid& G = F.grid;
+  const ShellObject& sh = *gs.shell;
+  const std::size_t nb = G.num_particle_blocks();
+  const Real dx = static_cast<Real>(G.dx());
   // The particle blocks that scatter to a split node.
   F.touched.assign(nb, -1);
   int num_touched = 0;
@@ -69,7 +71,6 @@ void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool seria
     }
   F.class_buf.resize(num_touched);
 
-  // 2. Both classes, summed as the whole shell was.
   parallel_for(
       nb, 1,
       [&](std::size_t bb, std::size_t be) {
@@ -82,26 +83,25 @@ void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool seria
           for (std::uint32_t q = G.pblock_start[b]; q < G.pblock_start[b + 1]; ++q) {
             const std::uint32_t j = G.order[q];
             const QuadraticWeights W(G.grid_coord(sh.x[j]));
-            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt,
-                               true);
-            const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-            for (int i = 0; i < 3; ++i)
-              for (int jj = 0; jj < 3; ++jj)
-                for (int k = 0; k < 3; ++k) {
-                  const int px = lx + i, py = ly + jj, pz = lz + k;
-                  const int g = nbr[(px >> 2) * 4 + (py >> 2) * 2 + (pz >> 2)];
-                  if (g < 0 || F.fold[g] < 0) continue;
-                  const FoldBlock& fb = F.folds[F.fold[g]];
-                  const int bn = block_node(px & 3, py & 3, pz & 3);
-                  if (!is_split(fb, bn)) continue;
-                  const int c = fold_height(P.n, P.fx, i, jj, k) >= fb.cut[bn] ? 1 : 0;
-                  P.add(buf[pad_node(px, py, pz)].c[c], W.w[0][i] * W.w[1][jj] * W.w[2][k], i,
-                        jj, k);
-                }
+            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, true);
+            for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+              const int g = nbr[(n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2)];
+              if (g < 0 || F.fold[g] < 0) return;
+              const FoldBlock& fb = F.folds[F.fold[g]];
+              const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
+              if (!is_split(fb, bn)) return;
+              const int c = fold_height(P.n, P.fx, n.i, n.j, n.k) >= fb.cut[bn] ? 1 : 0;
+              P.add(buf[n.pad()].c[c], n.w, n.i, n.j, n.k);
+            });
           }
         }
       },
       serial);
+}
+
+void ShellFields::gather_classes(Field& F, bool serial) {
+  const SparseGrid& G = F.grid;
+  const std::size_t ng = G.num_grid_blocks();
   parallel_for(
       ng, 4,
       [&](std::size_t gb, std::size_t ge) {
@@ -130,6 +130,16 @@ void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool seria
         }
       },
       serial);
+}
+
+void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool serial) {
+  // 1. The nodes whose heights spread: cut at the midpoint.
+  mark_split_nodes(F);
+  if (F.folds.empty()) return;
+  // 2. Both classes, summed as the whole shell was, on the particle blocks that scatter to
+  //    a split node; a node stays whole where one class is empty.
+  scatter_classes(F, gs, dt, serial);
+  gather_classes(F, serial);
 }
 
 }  // namespace shellmpm
