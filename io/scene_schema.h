@@ -1,7 +1,7 @@
 // The scene format as data: one KeySpec row per key, in document order. A row says the
 // key's type, presence, default, unit, range and rules (validation and docs/scene-format.md
 // come from it), and, where the value goes straight into a struct field, binds that field
-// (KeySpec::binding; see scene_schema.cpp), so a key is written once.
+// (KeySpec::binding; the table is io/scene_schema_table.cpp), so a key is written once.
 #pragma once
 #include <functional>
 #include <limits>
