@@ -6,6 +6,7 @@
 #include "app/commands.h"
 #include "io/user_error.h"
 #include "sim/core/check.h"
+#include "sim/scene/scene_words.h"
 #include "sim/solver/solver.h"
 
 namespace {
@@ -62,7 +63,7 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--size", render.size, "image size WxH (e.g. 1280x720)");
   render_cmd
       ->add_option("--renderer", render.renderer, "raster (OpenGL, OSMesa) or raytrace (Embree)")
-      ->check(CLI::IsMember({"raster", "raytrace"}));
+      ->check(CLI::IsMember(words_of<RendererKind>()));
   render_cmd
       ->add_option("--threads", render.threads,
                    "threads for TBB, Embree and llvmpipe (0 = all cores)")

@@ -86,7 +86,7 @@ void read_sources(MapReader& top, Scene& scene) {
   NameSet names("source");
   top.each("sources", false, [&](MapReader& r, std::size_t i) {
     SourceDesc src;
-    src.name = r.has("name") ? r.string("name") : "source" + std::to_string(i);
+    src.name = name_or_default(r, "source", i);
     names.add(src.name, r.path(), r.origin_of("name"), r.path_of("name"));
     src.material = index_by_name(scene.materials, r.string("material"), "material", "materials",
                                  r.origin_of("material"), r.path_of("material"));
@@ -113,7 +113,7 @@ void read_colliders(MapReader& top, Scene& scene) {
   NameSet names("collider");
   top.each("colliders", false, [&](MapReader& r, std::size_t i) {
     ColliderDesc c;
-    c.name = r.has("name") ? r.string("name") : "collider" + std::to_string(i);
+    c.name = name_or_default(r, "collider", i);
     names.add(c.name, r.path(), r.origin_of("name"), r.path_of("name"));
     c.shape = read_shape(*r.block("shape"), r.path_of("shape"), false, scene.path);
     check_collider_range(r, c.shape, scene.shot);

@@ -113,6 +113,10 @@ std::string index_range_message(long long index, long long num_vertices, const s
          (num_vertices > 0 ? " (0.." + std::to_string(num_vertices - 1) + ")" : "");
 }
 
+std::string name_or_default(MapReader& r, const std::string& kind, std::size_t i) {
+  return r.has("name") ? r.string("name") : kind + std::to_string(i);
+}
+
 bool file_name_safe(const std::string& name) {
   if (name.empty()) return false;
   for (char c : name) {

@@ -50,6 +50,9 @@ void require_in_position_range(const Vec3d& p, const ShotSettings& shot, const O
 /// "index 121 is out of range: the sheet has 121 vertices (0..120)".
 std::string index_range_message(long long index, long long num_vertices, const std::string& what);
 
+/// The item's `name`, or `<kind><i>` ("source2") when it gives none.
+std::string name_or_default(MapReader& r, const std::string& kind, std::size_t i);
+
 /// Names used in output file names: [A-Za-z0-9_-]+.
 bool file_name_safe(const std::string& name);
 

@@ -161,7 +161,7 @@ std::vector<PointLoadDesc> read_point_loads(MapReader& r, long long num_vertices
 
 ShellDesc read_shell(MapReader& r, std::size_t i, const Scene& scene, NameSet& names) {
   ShellDesc sh;
-  sh.name = r.has("name") ? r.string("name") : "shell" + std::to_string(i);
+  sh.name = name_or_default(r, "shell", i);
   if (!file_name_safe(sh.name)) {
     fail(r.origin_of("name"), r.path_of("name"),
          "shell name '" + sh.name +

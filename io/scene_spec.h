@@ -1,8 +1,10 @@
 // The builder the schema table (io/scene_schema_table.cpp) is written with: one Spec per
 // key, reading like the documentation, binding the struct field the value fills.
 #pragma once
+#include <array>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <typeindex>
 #include <utility>
@@ -80,10 +82,13 @@ class Spec {
     const bool range = k_.type == KeyType::FrameRange;
     return bind<S>(
         [=](MapReader& r, const std::string& name, S& s) {
-          const std::pair<int, int> v =
-              range ? r.frames(name) : std::pair<int, int>(r.int2(name)[0], r.int2(name)[1]);
-          s.*first = v.first;
-          s.*second = v.second;
+          if (range) {
+            std::tie(s.*first, s.*second) = r.frames(name);
+          } else {
+            const std::array<int, 2> v = r.int2(name);
+            s.*first = v[0];
+            s.*second = v[1];
+          }
         },
         [=](const S& a, const S& b) { return a.*first == b.*first && a.*second == b.*second; });
   }

@@ -24,14 +24,9 @@ MeshFormat parse_mesh_format(const std::string& name) {
 }
 
 const char* mesh_format_extension(MeshFormat format) {
-  switch (format) {
-    case MeshFormat::Ply:
-      return "ply";
-    case MeshFormat::Obj:
-      return "obj";
-    case MeshFormat::Glb:
-      return "glb";
-  }
+  // The scene-format words are string literals, so their data is null-terminated.
+  for (const Word<MeshFormat>& w : EnumWords<MeshFormat>::table)
+    if (w.value == format) return w.text.data();
   return "";
 }
 
