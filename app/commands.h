@@ -43,7 +43,34 @@ struct RenderArgs {
   Verbosity verbosity = Verbosity::Normal;
 };
 
+/// `shellmpm study`: the accuracy-vs-time study over the reference problems.
+struct StudyArgs {
+  std::vector<std::string> suites;  ///< problem names, or "all"
+  double budget = 3600;             ///< [s]
+  std::string output = "out/study";
+  int threads = 0;
+  bool quick = false;      ///< two settings of each problem's first sweep
+  bool keep_runs = false;  ///< keep every run's caches
+  bool plots = true;
+  std::string scenes;       ///< folder of the problems' scenes; default: the source tree's
+  std::string plot_script;  ///< default: the source tree's tools/plot_study.py
+  Verbosity verbosity = Verbosity::Normal;
+};
+
+/// `shellmpm converge SCENE`: a quantity of the user's shot over refinements of a knob.
+struct ConvergeArgs : CommonArgs {
+  std::vector<std::string> vary;  ///< KEY=V1,V2,... (repeatable: keys moved together)
+  std::string measure;
+  std::string frames;
+  int at_frame = 0;
+  std::vector<double> spacing;  ///< --h
+  std::string output = "out/converge";
+  bool keep_runs = false;
+};
+
 int run_command(const RunArgs& a);
+int study_command(const StudyArgs& a);
+int converge_command(const ConvergeArgs& a);
 int check_command(const CommonArgs& a);
 int render_command(const RenderArgs& a);
 

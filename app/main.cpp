@@ -78,6 +78,49 @@ int main(int argc, char** argv) {
   render_cmd->add_flag_callback(
       "--verbose,-v", [&render] { render.verbosity = Verbosity::Verbose; }, "per-frame timings");
 
+  StudyArgs study;
+  CLI::App* study_cmd = app.add_subcommand(
+      "study", "the accuracy-vs-time study: reference problems over sweeps of settings");
+  study_cmd
+      ->add_option("--suite", study.suites,
+                   "reference problems to run (names, or all; repeatable; default all)")
+      ->take_all();
+  study_cmd->add_option("--budget", study.budget, "no run starts after this many seconds")
+      ->check(CLI::PositiveNumber);
+  study_cmd->add_option("--output,-o", study.output, "results folder (default out/study)");
+  study_cmd->add_option("--threads", study.threads, "threads of every run (0 = all cores)")
+      ->check(CLI::NonNegativeNumber);
+  study_cmd->add_flag("--quick", study.quick,
+                      "two settings of each problem's first sweep (a smoke test)");
+  study_cmd->add_flag("--keep-runs", study.keep_runs, "keep every run's caches");
+  study_cmd->add_flag_callback(
+      "--no-plots", [&study] { study.plots = false; }, "do not call tools/plot_study.py");
+  study_cmd->add_option("--scenes", study.scenes, "folder of the problems' scenes");
+  study_cmd->add_option("--plot-script", study.plot_script, "the plotting script");
+  study_cmd->add_flag_callback(
+      "--quiet,-q", [&study] { study.verbosity = Verbosity::Quiet; }, "errors only");
+
+  ConvergeArgs converge;
+  CLI::App* converge_cmd = app.add_subcommand(
+      "converge", "a quantity of a shot over refinements: observed order, Richardson estimate");
+  add_common(converge_cmd, converge);
+  converge_cmd
+      ->add_option("--vary", converge.vary,
+                   "KEY=V1,V2,V3 (repeatable: keys varied together, as many values each)")
+      ->required();
+  converge_cmd
+      ->add_option("--measure", converge.measure,
+                   "quantity: shell.NAME.lowest, shell.NAME.centroid.y, bulk.max.x, "
+                   "stats.kinetic_energy, max:stats.KEY, ... (see README)")
+      ->required();
+  converge_cmd->add_option("--frames", converge.frames, "frame range A-B of every run");
+  converge_cmd->add_option("--at", converge.at_frame, "frame measured (default: the last)")
+      ->check(CLI::PositiveNumber);
+  converge_cmd->add_option("--h", converge.spacing, "spacing of each setting (default: inferred)")
+      ->delimiter(',');
+  converge_cmd->add_option("--output,-o", converge.output, "folder of the runs (default out/converge)");
+  converge_cmd->add_flag("--keep-runs", converge.keep_runs, "keep every run's caches");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -88,6 +131,8 @@ int main(int argc, char** argv) {
     if (*run_cmd) return run_command(run);
     if (*check_cmd) return check_command(check);
     if (*render_cmd) return render_command(render);
+    if (*study_cmd) return study_command(study);
+    if (*converge_cmd) return converge_command(converge);
   } catch (const UserError& e) {
     std::fprintf(stderr, "\nerror: %s\n", e.what());
     return kExitUserError;
