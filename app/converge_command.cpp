@@ -37,8 +37,8 @@ int converge_command(const ConvergeArgs& a) {
   std::printf("\n%-40s %16s %10s %10s %10s\n", "setting", r.quantity.c_str(), "h", "wall s",
               "substeps");
   for (const ConvergeSetting& s : r.settings)
-    std::printf("%-40s %16.8g %10.4g %10.2f %10ld\n", s.label.c_str(), s.value, s.h,
-                s.wall_seconds, s.substeps);
+    std::printf("%-40s %16.8g %10.4g %10.2f %10ld\n", s.label.c_str(), s.value, s.h, s.wall_seconds,
+                s.substeps);
   if (r.extrapolation) {
     const Extrapolation& e = *r.extrapolation;
     std::printf(

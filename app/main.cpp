@@ -118,7 +118,8 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   converge_cmd->add_option("--h", converge.spacing, "spacing of each setting (default: inferred)")
       ->delimiter(',');
-  converge_cmd->add_option("--output,-o", converge.output, "folder of the runs (default out/converge)");
+  converge_cmd->add_option("--output,-o", converge.output,
+                           "folder of the runs (default out/converge)");
   converge_cmd->add_flag("--keep-runs", converge.keep_runs, "keep every run's caches");
 
   try {

@@ -4,10 +4,10 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "io/study/child_run.h"
 #include "io/study/plots.h"
 #include "io/study/study_report.h"
 #include "io/study/study_runner.h"
-#include "io/study/child_run.h"
 
 namespace shellmpm {
 

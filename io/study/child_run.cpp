@@ -58,7 +58,8 @@ ChildRunResult run_process(const std::vector<std::string>& argv_in, const std::s
 
   const auto t0 = std::chrono::steady_clock::now();
   const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error(std::string("cannot start ") + args[0] + ": " + std::strerror(errno));
+  if (pid < 0)
+    throw std::runtime_error(std::string("cannot start ") + args[0] + ": " + std::strerror(errno));
   if (pid == 0) {
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (fd >= 0) {
@@ -77,8 +78,7 @@ ChildRunResult run_process(const std::vector<std::string>& argv_in, const std::s
     if (errno != EINTR) throw std::runtime_error(std::string("wait4: ") + std::strerror(errno));
   }
   ChildRunResult out;
-  out.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.peak_rss_bytes = static_cast<double>(ru.ru_maxrss) * 1024.0;  // Linux: kilobytes
   out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   out.log_tail = tail_of(log, 600);

@@ -19,10 +19,10 @@ struct ChildRunRequest {
 };
 
 struct ChildRunResult {
-  int exit_code = -1;          ///< the child's exit status; 128 + signal when killed
-  double wall_seconds = 0;     ///< from start to exit
-  double peak_rss_bytes = 0;   ///< ru_maxrss of the child
-  std::string log_tail;        ///< the last lines it printed (for error messages)
+  int exit_code = -1;         ///< the child's exit status; 128 + signal when killed
+  double wall_seconds = 0;    ///< from start to exit
+  double peak_rss_bytes = 0;  ///< ru_maxrss of the child
+  std::string log_tail;       ///< the last lines it printed (for error messages)
 };
 
 /// Runs `binary run SCENE -o OUTPUT --quiet --threads N [--frames F] --set ...` and waits.

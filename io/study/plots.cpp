@@ -37,8 +37,8 @@ PlotOutcome make_study_plots(const std::string& script, const std::string& resul
     if (probe.exit_code != 0) continue;
     const ChildRunResult r = run_process({py, script, results_json, outdir}, log);
     if (r.exit_code != 0) {
-      out.message = "plots failed (" + py + " " + script + ", exit " +
-                    std::to_string(r.exit_code) + "): " + r.log_tail;
+      out.message = "plots failed (" + py + " " + script + ", exit " + std::to_string(r.exit_code) +
+                    "): " + r.log_tail;
       return out;
     }
     out.made = true;

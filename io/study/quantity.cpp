@@ -27,7 +27,9 @@ std::vector<std::string> split_dots(const std::string& s) {
   return parts;
 }
 
-int axis_of(const std::string& s) { return s == "x" ? 0 : s == "y" ? 1 : s == "z" ? 2 : -1; }
+int axis_of(const std::string& s) {
+  return s == "x" ? 0 : s == "y" ? 1 : s == "z" ? 2 : -1;
+}
 
 [[noreturn]] void bad(const std::string& where, const std::string& text, const std::string& why) {
   throw UserError(where + " " + text, 0, "", why);

@@ -23,15 +23,16 @@ struct StudySweep {
   std::string name;    ///< "mesh resolution"
   std::string varied;  ///< the keys it changes, in words
   std::string held;    ///< what stays as the scene says
-  bool refinement = false;  ///< settings run coarse to fine and carry h: a convergence order is fitted
+  bool refinement =
+      false;  ///< settings run coarse to fine and carry h: a convergence order is fitted
   std::vector<StudySetting> settings;
 };
 
 struct ReferenceProblem {
-  std::string name;       ///< "plate_simply_supported": also the scene file's stem
-  std::string title;      ///< one line
-  std::string quantity;   ///< what is measured, in words
-  std::string unit;       ///< of the quantity
+  std::string name;              ///< "plate_simply_supported": also the scene file's stem
+  std::string title;             ///< one line
+  std::string quantity;          ///< what is measured, in words
+  std::string unit;              ///< of the quantity
   std::string reference_source;  ///< the formula and where it comes from
   bool relative_error = true;    ///< false: the error is value - reference in `unit`
   bool needs_particles = false;  ///< the run writes a particle cache

@@ -36,6 +36,13 @@ double lowest_y(const std::vector<Vec3d>& x) {
   return lo;
 }
 
+/// The last component of a key path: "quadrature_inplane" of
+/// "shell_materials[0].quadrature_inplane", for short labels.
+std::string short_key(const std::string& key) {
+  const std::size_t dot = key.rfind('.');
+  return dot == std::string::npos ? key : key.substr(dot + 1);
+}
+
 /// A sweep over one integer key.
 StudySweep int_sweep(const std::string& name, const std::string& key, std::vector<int> values,
                      const std::string& held) {
@@ -43,17 +50,20 @@ StudySweep int_sweep(const std::string& name, const std::string& key, std::vecto
   w.name = name;
   w.varied = key;
   w.held = held;
-  for (int v : values) w.settings.push_back({key + "=" + std::to_string(v), {key + "=" + std::to_string(v)}, 0});
+  for (int v : values)
+    w.settings.push_back(
+        {short_key(key) + "=" + std::to_string(v), {key + "=" + std::to_string(v)}, 0});
   return w;
 }
 
-StudySweep number_sweep(const std::string& name, const std::string& key,
-                        std::vector<double> values, const std::string& held) {
+StudySweep number_sweep(const std::string& name, const std::string& key, std::vector<double> values,
+                        const std::string& held) {
   StudySweep w;
   w.name = name;
   w.varied = key;
   w.held = held;
-  for (double v : values) w.settings.push_back({key + "=" + num(v), {key + "=" + num(v)}, 0});
+  for (double v : values)
+    w.settings.push_back({short_key(key) + "=" + num(v), {key + "=" + num(v)}, 0});
   return w;
 }
 
@@ -88,7 +98,8 @@ ReferenceProblem plate() {
   res.refinement = true;
   for (int n : {8, 16, 32, 64}) {
     const std::string v = "[" + std::to_string(n) + ", " + std::to_string(n) + "]";
-    res.settings.push_back({"n=" + std::to_string(n), {"shells[0].geometry.resolution=" + v}, 0.2 / n});
+    res.settings.push_back(
+        {"n=" + std::to_string(n), {"shells[0].geometry.resolution=" + v}, 0.2 / n});
   }
   p.sweeps.push_back(res);
   p.sweeps.push_back(int_sweep("in-plane quadrature", "shell_materials[0].quadrature_inplane",
@@ -162,9 +173,9 @@ ReferenceProblem cantilever_vibration() {
     const ShellMaterialDesc& m = material_of(s, d);
     const double L = cantilever_length(d);
     const double beta = 1.8751040687;
-    const double omega = beta * beta *
-                         std::sqrt(m.youngs_modulus * m.thickness * m.thickness / (12 * m.density)) /
-                         (L * L);
+    const double omega =
+        beta * beta * std::sqrt(m.youngs_modulus * m.thickness * m.thickness / (12 * m.density)) /
+        (L * L);
     return 2 * kPi / omega;
   };
   p.measure = [](const RunFolder& r, const Scene&) {
@@ -222,10 +233,10 @@ std::vector<StudySweep> incline_sweeps(bool on_sheet) {
   dx.refinement = true;
   for (double h : {0.04, 0.02, 0.01}) {
     const int n = static_cast<int>(std::lround(0.16 / h));
-    StudySetting st{"dx=" + num(h),
-                    {"shot.dx=" + num(h),
-                     res_key + "=[" + std::to_string(n) + ", " + std::to_string(n) + "]"},
-                    h};
+    StudySetting st{
+        "dx=" + num(h),
+        {"shot.dx=" + num(h), res_key + "=[" + std::to_string(n) + ", " + std::to_string(n) + "]"},
+        h};
     if (on_sheet) {
       const int nb = static_cast<int>(std::lround(0.8 / h));
       st.overrides.push_back("shells[0].geometry.resolution=[" + std::to_string(nb) + ", " +
@@ -251,8 +262,8 @@ std::vector<StudySweep> incline_sweeps(bool on_sheet) {
     v.varied = "shot.shell_velocities";
     v.held = "dx 0.02, mesh spacing dx";
     for (const char* w : {"per_shell", "shared"})
-      v.settings.push_back({std::string("shell_velocities=") + w,
-                            {std::string("shot.shell_velocities=") + w}, 0});
+      v.settings.push_back(
+          {std::string("shell_velocities=") + w, {std::string("shot.shell_velocities=") + w}, 0});
     out.push_back(v);
   }
   return out;
@@ -326,10 +337,11 @@ ReferenceProblem sand_column() {
   dx.varied = "shot.dx";
   dx.held = "8 particles per cell";
   dx.refinement = true;
-  for (double h : {0.02, 0.01, 0.005}) dx.settings.push_back({"dx=" + num(h), {"shot.dx=" + num(h)}, h});
+  for (double h : {0.02, 0.01, 0.005})
+    dx.settings.push_back({"dx=" + num(h), {"shot.dx=" + num(h)}, h});
   p.sweeps.push_back(dx);
-  p.sweeps.push_back(number_sweep("particles per cell", "sources[0].particles_per_cell",
-                                  {4, 8, 16}, "dx 0.01"));
+  p.sweeps.push_back(
+      number_sweep("particles per cell", "sources[0].particles_per_cell", {4, 8, 16}, "dx 0.01"));
   return p;
 }
 
@@ -362,10 +374,11 @@ ReferenceProblem bar_impact() {
   dx.varied = "shot.dx";
   dx.held = "8 particles per cell, APIC, CFL 0.3";
   dx.refinement = true;
-  for (double h : {0.02, 0.01, 0.005}) dx.settings.push_back({"dx=" + num(h), {"shot.dx=" + num(h)}, h});
+  for (double h : {0.02, 0.01, 0.005})
+    dx.settings.push_back({"dx=" + num(h), {"shot.dx=" + num(h)}, h});
   p.sweeps.push_back(dx);
-  p.sweeps.push_back(number_sweep("particles per cell", "sources[0].particles_per_cell",
-                                  {1, 8, 27}, "dx 0.01, APIC, CFL 0.3"));
+  p.sweeps.push_back(number_sweep("particles per cell", "sources[0].particles_per_cell", {1, 8, 27},
+                                  "dx 0.01, APIC, CFL 0.3"));
   StudySweep tr;
   tr.name = "transfer";
   tr.varied = "shot.transfer";
@@ -405,10 +418,11 @@ ReferenceProblem drape_sphere() {
   dx.refinement = true;
   for (double h : {0.04, 0.02, 0.01}) {
     const int n = static_cast<int>(std::lround(0.3 / h));
-    dx.settings.push_back({"dx=" + num(h),
-                           {"shot.dx=" + num(h), "shells[0].geometry.resolution=[" +
-                                                     std::to_string(n) + ", " + std::to_string(n) + "]"},
-                           h});
+    dx.settings.push_back(
+        {"dx=" + num(h),
+         {"shot.dx=" + num(h),
+          "shells[0].geometry.resolution=[" + std::to_string(n) + ", " + std::to_string(n) + "]"},
+         h});
   }
   p.sweeps.push_back(dx);
   return p;
@@ -417,8 +431,8 @@ ReferenceProblem drape_sphere() {
 }  // namespace
 
 std::vector<ReferenceProblem> reference_problems() {
-  return {plate(),        cantilever_static(), cantilever_vibration(), incline_collider(),
-          incline_sheet(), sand_column(),      bar_impact(),           drape_sphere()};
+  return {plate(),         cantilever_static(), cantilever_vibration(), incline_collider(),
+          incline_sheet(), sand_column(),       bar_impact(),           drape_sphere()};
 }
 
 }  // namespace shellmpm

@@ -6,7 +6,8 @@
 
 namespace shellmpm {
 
-std::optional<Extrapolation> richardson(const std::vector<double>& h, const std::vector<double>& q) {
+std::optional<Extrapolation> richardson(const std::vector<double>& h,
+                                        const std::vector<double>& q) {
   if (h.size() != q.size() || h.size() < 3) return std::nullopt;
   std::vector<std::size_t> idx(h.size());
   std::iota(idx.begin(), idx.end(), 0);

@@ -10,9 +10,9 @@ namespace shellmpm {
 
 /// What three or more refinements say about the limit.
 struct Extrapolation {
-  double order = 0;  ///< observed order p (q - q_inf ~ C h^p), from the three finest
-  double limit = 0;  ///< Richardson estimate of q at h -> 0
-  double error = 0;  ///< |q_finest - limit|: the estimated error left in the finest result
+  double order = 0;      ///< observed order p (q - q_inf ~ C h^p), from the three finest
+  double limit = 0;      ///< Richardson estimate of q at h -> 0
+  double error = 0;      ///< |q_finest - limit|: the estimated error left in the finest result
   bool monotone = true;  ///< false when the differences change sign (oscillatory: no order)
 };
 

@@ -9,12 +9,10 @@
 namespace shellmpm {
 
 std::vector<std::string> run_outputs_overrides(bool particles) {
-  std::vector<std::string> o = {"output.density=false",
-                                "output.stats=stats.json",
-                                "output.shell_format=ply",
-                                "output.shell_pattern='{name}.####.ply'",
-                                "output.checkpoint_every=0",
-                                "render.preview=false"};
+  std::vector<std::string> o = {
+      "output.density=false",      "output.stats=stats.json",
+      "output.shell_format=ply",   "output.shell_pattern='{name}.####.ply'",
+      "output.checkpoint_every=0", "render.preview=false"};
   o.push_back(std::string("output.particles=") + (particles ? "true" : "false"));
   if (particles) o.push_back("output.particles_pattern='particles.####.ply'");
   return o;
@@ -33,8 +31,12 @@ RunFolder::RunFolder(std::string dir) : dir_(std::move(dir)) {
     throw std::runtime_error(path + ": holds no frames");
 }
 
-int RunFolder::first_frame() const { return frames().front().at("frame").get<int>(); }
-int RunFolder::last_frame() const { return frames().back().at("frame").get<int>(); }
+int RunFolder::first_frame() const {
+  return frames().front().at("frame").get<int>();
+}
+int RunFolder::last_frame() const {
+  return frames().back().at("frame").get<int>();
+}
 
 const nlohmann::json& RunFolder::frame_stats(int frame) const {
   for (const nlohmann::json& f : frames())
@@ -42,7 +44,9 @@ const nlohmann::json& RunFolder::frame_stats(int frame) const {
   throw std::runtime_error(dir_ + "/stats.json: has no frame " + std::to_string(frame));
 }
 
-double RunFolder::time(int frame) const { return frame_stats(frame).at("time").get<double>(); }
+double RunFolder::time(int frame) const {
+  return frame_stats(frame).at("time").get<double>();
+}
 
 namespace {
 

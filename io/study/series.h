@@ -19,7 +19,8 @@ double fit_slope(const std::vector<double>& t, const std::vector<double>& v);
 /// Period of an oscillation about its mean: the mean spacing of same-direction crossings of
 /// the mean (linear interpolation between samples), from the first to the last crossing.
 /// Returns nothing with fewer than two upward (or two downward) crossings.
-std::optional<double> oscillation_period(const std::vector<double>& t, const std::vector<double>& s);
+std::optional<double> oscillation_period(const std::vector<double>& t,
+                                         const std::vector<double>& s);
 
 /// The first time s(t) reaches `level` going in the direction of `rising` (linear
 /// interpolation between samples); nothing when it never does.

@@ -123,14 +123,14 @@ void write_study_report(const StudyResults& r, const std::string& output) {
     for (const StudyRun& run : p.runs) {
       std::string ov;
       for (const std::string& o : run.overrides) ov += (ov.empty() ? "" : " ") + o;
-      csv << csv_field(p.name) << ',' << csv_field(run.sweep) << ',' << csv_field(run.label)
-          << ',' << csv_field(ov) << ',' << g(run.h) << ',' << g(run.dx) << ',' << run.status
-          << ',' << g(run.value, 8) << ',' << g(run.reference, 8) << ',' << g(run.error, 6) << ','
+      csv << csv_field(p.name) << ',' << csv_field(run.sweep) << ',' << csv_field(run.label) << ','
+          << csv_field(ov) << ',' << g(run.h) << ',' << g(run.dx) << ',' << run.status << ','
+          << g(run.value, 8) << ',' << g(run.reference, 8) << ',' << g(run.error, 6) << ','
           << (p.relative_error ? "relative" : "absolute") << ',' << g(run.wall_seconds, 4) << ','
           << g(run.simulated_seconds, 6) << ',' << g(run.cost, 5) << ',' << run.substeps << ','
           << run.particles << ',' << run.shell_points << ',' << run.contact_particles << ','
-          << g(run.peak_rss_bytes, 6) << ',' << (run.pareto ? 1 : 0) << ','
-          << csv_field(run.note) << '\n';
+          << g(run.peak_rss_bytes, 6) << ',' << (run.pareto ? 1 : 0) << ',' << csv_field(run.note)
+          << '\n';
     }
   write_text_atomic(output + "/results.csv", csv.str());
 

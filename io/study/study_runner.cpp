@@ -88,8 +88,8 @@ void run_one(const StudyOptions& opt, const ReferenceProblem& p, const std::stri
     const RunFolder rf(dir);
     read_counts(rf, r);
     r.value = p.measure(rf, scene);
-    r.error = p.relative_error ? (r.value - r.reference) / std::abs(r.reference)
-                               : r.value - r.reference;
+    r.error =
+        p.relative_error ? (r.value - r.reference) / std::abs(r.reference) : r.value - r.reference;
     r.status = std::isfinite(r.error) ? "ok" : "failed";
     if (r.status != "ok") r.note = "the measurement is not finite";
   } catch (const std::exception& e) {
@@ -183,8 +183,10 @@ StudyResults run_study(const StudyOptions& opt) {
         r.dx = scene.shot.dx;
         const std::string key = join(st.overrides, "\n");
         const auto same = by_overrides.find(key);
-        if (same != by_overrides.end()) r.reused_from = same->second;
-        else by_overrides[key] = static_cast<int>(pr.runs.size());
+        if (same != by_overrides.end())
+          r.reused_from = same->second;
+        else
+          by_overrides[key] = static_cast<int>(pr.runs.size());
         swr.runs.push_back(static_cast<int>(pr.runs.size()));
         pr.runs.push_back(r);
         plan.scenes.push_back(scene);

@@ -16,14 +16,14 @@
 namespace shellmpm {
 
 struct StudyOptions {
-  std::string binary;      ///< the shellmpm executable the runs use
-  std::string scenes_dir;  ///< where the problems' scenes are (scenes/study)
-  std::string output;      ///< results folder; runs go to OUTPUT/runs/
+  std::string binary;                 ///< the shellmpm executable the runs use
+  std::string scenes_dir;             ///< where the problems' scenes are (scenes/study)
+  std::string output;                 ///< results folder; runs go to OUTPUT/runs/
   std::vector<std::string> problems;  ///< names to run; empty: all
   int threads = 0;                    ///< --threads of every run (0: all cores)
   double budget_seconds = 3600;       ///< no run starts once this much wall time is spent
-  bool quick = false;      ///< only the first two settings of each problem's first sweep
-  bool keep_runs = false;  ///< keep each run's caches (else removed once measured)
+  bool quick = false;                 ///< only the first two settings of each problem's first sweep
+  bool keep_runs = false;             ///< keep each run's caches (else removed once measured)
   std::function<void(const std::string&)> log;  ///< progress lines
 };
 
@@ -40,7 +40,7 @@ struct StudyRun {
   double error = std::numeric_limits<double>::quiet_NaN();
   double wall_seconds = 0;
   double simulated_seconds = 0;  ///< 0 for static problems
-  double cost = 0;  ///< wall seconds per simulated second; wall seconds when static
+  double cost = 0;               ///< wall seconds per simulated second; wall seconds when static
   long substeps = 0;
   long particles = 0, shell_points = 0, contact_particles = 0;
   double peak_rss_bytes = 0;
@@ -52,8 +52,8 @@ struct StudyRun {
 struct StudySweepResult {
   std::string name, varied, held;
   bool refinement = false;
-  std::vector<int> runs;               ///< indices into StudyProblemResult::runs
-  std::optional<double> fitted_order;  ///< slope of log|error| against log h
+  std::vector<int> runs;                       ///< indices into StudyProblemResult::runs
+  std::optional<double> fitted_order;          ///< slope of log|error| against log h
   std::optional<Extrapolation> extrapolation;  ///< Richardson, from the three finest
 };
 

@@ -11,7 +11,9 @@ using namespace shellmpm_test;
 
 namespace {
 
-bool have_matplotlib() { return run_command("/usr/bin/python3 -c 'import matplotlib'").code == 0; }
+bool have_matplotlib() {
+  return run_command("/usr/bin/python3 -c 'import matplotlib'").code == 0;
+}
 
 }  // namespace
 
@@ -19,7 +21,8 @@ TEST_CASE("CLI: study --quick runs two resolutions of the plate; the error falls
           "[study][cli]") {
   TempDir dir("study_quick");
   const std::string out = dir.file("study");
-  const CmdResult r = run_shellmpm("study --suite plate_simply_supported --quick --threads 1 -o " + out);
+  const CmdResult r =
+      run_shellmpm("study --suite plate_simply_supported --quick --threads 1 -o " + out);
   INFO(r.output);
   REQUIRE(r.code == 0);
   const nlohmann::json j = nlohmann::json::parse(read_text(out + "/results.json"));
@@ -55,12 +58,13 @@ TEST_CASE("CLI: study --quick runs two resolutions of the plate; the error falls
   CHECK_FALSE(std::filesystem::exists(out + "/runs/plate_simply_supported/run0/stats.json"));
 }
 
-TEST_CASE("CLI: study without Python's matplotlib still writes results and says why", "[study][cli]") {
+TEST_CASE("CLI: study without Python's matplotlib still writes results and says why",
+          "[study][cli]") {
   TempDir dir("study_noplot");
   const std::string out = dir.file("study");
-  const CmdResult r = run_shellmpm(
-      "study --suite plate_simply_supported --quick --threads 1 -o " + out,
-      "SHELLMPM_PYTHON=/nonexistent PATH=/nowhere");
+  const CmdResult r =
+      run_shellmpm("study --suite plate_simply_supported --quick --threads 1 -o " + out,
+                   "SHELLMPM_PYTHON=/nonexistent PATH=/nowhere");
   INFO(r.output);
   // /usr/bin/python3 is tried by path even without PATH; the message or the plots appear.
   REQUIRE(r.code == 0);
@@ -76,19 +80,18 @@ TEST_CASE("CLI: study and converge refuse bad input with the flag or key named",
   CHECK(a.output.find("--suite nope") != std::string::npos);
   CHECK(a.output.find("plate_simply_supported") != std::string::npos);
   const std::string scene = dir.write("jelly.yaml", tiny_jelly_scene(3, dir.file("o")));
-  const CmdResult b = run_shellmpm("converge " + scene +
-                                   " --vary shot.nope=1,2 --measure bulk.centroid.y -o " +
-                                   dir.file("c"));
+  const CmdResult b = run_shellmpm(
+      "converge " + scene + " --vary shot.nope=1,2 --measure bulk.centroid.y -o " + dir.file("c"));
   CHECK(b.code == 2);
   CHECK(b.output.find("shot.nope") != std::string::npos);
-  const CmdResult c = run_shellmpm("converge " + scene +
-                                   " --vary shot.dx=0.1,0.05 --measure shell.cloth.lowest -o " +
-                                   dir.file("c"));
+  const CmdResult c =
+      run_shellmpm("converge " + scene +
+                   " --vary shot.dx=0.1,0.05 --measure shell.cloth.lowest -o " + dir.file("c"));
   CHECK(c.code == 2);
   CHECK(c.output.find("no shell 'cloth'") != std::string::npos);
-  const CmdResult d = run_shellmpm("converge " + scene +
-                                   " --vary shot.dx=0.1,0.05,x --measure bulk.centroid.y -o " +
-                                   dir.file("c"));
+  const CmdResult d =
+      run_shellmpm("converge " + scene +
+                   " --vary shot.dx=0.1,0.05,x --measure bulk.centroid.y -o " + dir.file("c"));
   CHECK(d.code == 2);
   CHECK(d.output.find("shot.dx") != std::string::npos);
 }
@@ -99,7 +102,8 @@ TEST_CASE("CLI: converge measures a shot at three spacings and extrapolates", "[
   const std::string out = dir.file("conv");
   const CmdResult r = run_shellmpm("converge " + scene +
                                    " --vary shot.dx=0.1,0.05,0.025 --measure bulk.centroid.y "
-                                   "--threads 1 -o " + out);
+                                   "--threads 1 -o " +
+                                   out);
   INFO(r.output);
   REQUIRE(r.code == 0);
   const nlohmann::json j = nlohmann::json::parse(read_text(out + "/converge.json"));

@@ -46,7 +46,7 @@ struct Seed {
 std::vector<Seed> seeds() {
   const fs::path root(SHELLMPM_SOURCE_DIR);
   std::vector<fs::path> files;
-  for (const char* dir : {"scenes", "scenes/stress", "tests/data/scenes"})
+  for (const char* dir : {"scenes", "scenes/stress", "scenes/study", "tests/data/scenes"})
     for (const auto& e : fs::directory_iterator(root / dir))
       if (e.path().extension() == ".yaml" && e.path().filename().string().rfind("bad_", 0) != 0)
         files.push_back(e.path());

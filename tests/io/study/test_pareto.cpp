@@ -18,8 +18,8 @@ StudyRun run(double cost, double error, const std::string& status = "ok") {
 }  // namespace
 
 TEST_CASE("mark_pareto_front keeps exactly the undominated runs", "[study]") {
-  std::vector<StudyRun> runs = {run(1, 0.10), run(2, -0.05), run(3, 0.07), run(4, 0.01),
-                                run(0.5, 0.5, "failed"), run(2, 0.05)};
+  std::vector<StudyRun> runs = {run(1, 0.10), run(2, -0.05),           run(3, 0.07),
+                                run(4, 0.01), run(0.5, 0.5, "failed"), run(2, 0.05)};
   mark_pareto_front(runs);
   CHECK(runs[0].pareto);        // cheapest
   CHECK(runs[1].pareto);        // |error| counts, not its sign

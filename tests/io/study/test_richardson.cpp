@@ -8,7 +8,8 @@ using namespace shellmpm;
 
 TEST_CASE("richardson recovers order and limit of q = q0 + C h^p", "[study]") {
   for (double p : {1.0, 2.0, 1.5}) {
-    for (auto hs : {std::vector<double>{0.04, 0.02, 0.01}, std::vector<double>{0.03, 0.02, 0.005}}) {
+    for (auto hs :
+         {std::vector<double>{0.04, 0.02, 0.01}, std::vector<double>{0.03, 0.02, 0.005}}) {
       std::vector<double> q;
       for (double h : hs) q.push_back(2.5 - 3.0 * std::pow(h, p));
       const auto e = richardson(hs, q);
