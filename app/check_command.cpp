@@ -3,6 +3,9 @@
 #include "app/commands.h"
 #include "app/scene_loading.h"
 #include "io/available_memory.h"
+#include "io/scene_quality.h"
+#include "io/study/preset_errors.h"
+#include "sim/scene/scene_words.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/shot_estimate.h"
 #include "sim/solver/solver.h"
@@ -122,6 +125,38 @@ void print_time(const Solver& solver, const RunMemory& mem) {
         describe_step_limits(limits, s.dt_min).c_str());
 }
 
+/// The preset's resolved values (what it set), then what the accuracy study measured with it
+/// on the reference problems nearest to this scene.
+void print_quality(const Scene& scene) {
+  if (!scene.shot.quality) return;
+  const Quality q = *scene.shot.quality;
+  const QualityPreset p = quality_preset(q);
+  std::printf(
+      "quality %s: dx %g m (%.3gx the scene's), sheet and cylinder resolutions / %.3g; cfl %g",
+      word_of(q).c_str(), scene.shot.dx, p.dx_factor, p.dx_factor, scene.shot.cfl);
+  for (const ShellMaterialDesc& m : scene.shell_materials)
+    std::printf("; %s: quadrature %d x %d, contact samples %d", m.name.c_str(),
+                m.quadrature_inplane, m.quadrature_thickness, m.contact_samples);
+  for (const SourceDesc& src : scene.sources)
+    std::printf("; %s: %g particles per cell", src.name.c_str(), src.particles_per_cell);
+  std::printf(" (keys the scene sets itself keep their values)\n");
+  const std::string results = std::string(SHELLMPM_SOURCE_DIR) + "/docs/accuracy/results.json";
+  const std::vector<PresetMeasurement> m =
+      preset_measurements(results, q, nearest_problems(scene));
+  if (m.empty()) {
+    std::printf("  no study results for this preset in %s (run `shellmpm study`)\n",
+                results.c_str());
+    return;
+  }
+  std::printf("  measured with this preset (docs/accuracy.md):");
+  for (const PresetMeasurement& x : m) {
+    std::printf(" %s %s", x.problem.c_str(), x.error.c_str());
+    if (x.cost_vs_production > 0) std::printf(" at %.2gx production's time", x.cost_vs_production);
+    std::printf(";");
+  }
+  std::printf("\n");
+}
+
 }  // namespace
 
 int check_command(const CommonArgs& a) {
@@ -133,6 +168,7 @@ int check_command(const CommonArgs& a) {
   std::printf("frames %d-%d at %g fps, dx %g m, domain [%g %g %g]..[%g %g %g]\n", s.frame_start,
               s.frame_end, s.fps, s.dx, s.domain_min.x(), s.domain_min.y(), s.domain_min.z(),
               s.domain_max.x(), s.domain_max.y(), s.domain_max.z());
+  print_quality(scene);
   const RunMemory mem = estimate_memory(ls);
   const AvailableMemory avail = available_memory();
   print_estimate(mem, avail);

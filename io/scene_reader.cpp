@@ -16,6 +16,7 @@
 #include "io/number_text.h"
 #include "io/scene_checks.h"
 #include "io/scene_overrides.h"
+#include "io/scene_quality.h"
 #include "io/scene_sections.h"
 #include "io/utf8.h"
 #include "sim/core/check.h"
@@ -275,6 +276,7 @@ Scene parse_scene(const std::string& text, const std::string& path,
     fail(root.origin, "", "expected a mapping of keys at the top level, got " + describe(root));
   }
   for (const std::string& ov : overrides) apply_override(root, ov);
+  apply_quality(root);
   return build_scene(root, path);
 }
 

@@ -100,6 +100,10 @@ std::vector<KeySpec> build_schema() {
           .rule("at most 2^20 cells per axis"),
       Spec("shot.threads", T::Int).to(&ShotSettings::threads).def("0").ge(0),
       Spec("shot.transfer", T::Enum).to(&ShotSettings::transfer).def("apic"),
+      Spec("shot.quality", T::Enum)
+          .to(&ShotSettings::quality)
+          .optional("none: every value as written")
+          .rule("see docs/accuracy.md#quality-presets"),
       Spec("shot.shell_velocities", T::Enum).to(&ShotSettings::shell_velocities).def("per_shell"),
       Spec("shot.fold_fields", T::Bool).to(&ShotSettings::fold_fields).def("true"),
       Spec("shot.shell_guard", T::Bool).to(&ShotSettings::shell_guard).def("true"),

@@ -1,6 +1,7 @@
 // The builder the schema table (io/scene_schema_table.cpp) is written with: one Spec per
 // key, reading like the documentation, binding the struct field the value fills.
 #pragma once
+#include <optional>
 #include <array>
 #include <memory>
 #include <string>
@@ -15,6 +16,13 @@
 #include "sim/scene/scene_words.h"
 
 namespace shellmpm::scenefile {
+
+namespace detail {
+template <class T>
+struct is_optional_enum : std::false_type {};
+template <class E>
+struct is_optional_enum<std::optional<E>> : std::is_enum<E> {};
+}  // namespace detail
 
 /// Builder for one KeySpec, so the schema table below reads like the documentation.
 class Spec {
@@ -69,10 +77,13 @@ class Spec {
     k_.color = true;
     return rule("linear RGB, each in [0, 1]");
   }
-  /// Binds the struct field the value fills; an enum field's words become the choices.
+  /// Binds the struct field the value fills; an enum field's words (or an optional enum's)
+  /// become the choices.
   template <class S, class F>
   Spec& to(F S::*field) {
     if constexpr (std::is_enum_v<F>) k_.choices = words_of<F>();
+    if constexpr (detail::is_optional_enum<F>::value)
+      k_.choices = words_of<typename F::value_type>();
     return bind<S>([field](MapReader& r, const std::string& name, S& s) { r.get(name, s.*field); },
                    [field](const S& a, const S& b) { return bool(a.*field == b.*field); });
   }

@@ -238,7 +238,7 @@ std::vector<StudySweep> incline_sweeps(bool on_sheet) {
         {"shot.dx=" + num(h), res_key + "=[" + std::to_string(n) + ", " + std::to_string(n) + "]"},
         h};
     if (on_sheet) {
-      const int nb = static_cast<int>(std::lround(0.8 / h));
+      const int nb = static_cast<int>(std::lround(0.6 / h));
       st.overrides.push_back("shells[0].geometry.resolution=[" + std::to_string(nb) + ", " +
                              std::to_string(nb) + "]");
     }

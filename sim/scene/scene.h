@@ -15,6 +15,11 @@ namespace shellmpm {
 
 /// The particle-grid transfer: quadratic B-spline APIC, or MLS-MPM (Hu et al. 2018).
 enum class Transfer { Apic, Mls };
+
+/// Accuracy presets (`shot.quality`, io/scene_quality.h): grid and sheet resolution
+/// relative to the scene's, and CFL, quadrature, contact samples and particles per cell
+/// where the scene does not set them. Chosen on the accuracy study's front (docs/accuracy.md).
+enum class Quality { Draft, Preview, Production, Final };
 /// Whether shells that share grid nodes share one velocity there (no-slip between them, as
 /// in the paper) or each keeps its own (ShellFields; friction from contact only).
 enum class ShellVelocities { PerShell, Shared };
@@ -33,6 +38,8 @@ struct ShotSettings {
   double dx = 0.02;  ///< grid spacing [m]
   int threads = 0;   ///< 0 = all cores
   Transfer transfer = Transfer::Apic;
+  /// The accuracy preset the reader applied (io/scene_quality.h); none: values as written.
+  std::optional<Quality> quality;
   ShellVelocities shell_velocities = ShellVelocities::PerShell;
   /// True: where two layers of one shell meet at a node they get two velocities there
   /// (sim/contact/shell_folds.cpp), so a fold slides over its own cloth at Coulomb's law;

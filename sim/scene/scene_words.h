@@ -31,6 +31,8 @@ struct EnumWords;
   }
 
 SHELLMPM_ENUM_WORDS(Transfer, 2, {"apic", Transfer::Apic}, {"mls", Transfer::Mls});
+SHELLMPM_ENUM_WORDS(Quality, 4, {"draft", Quality::Draft}, {"preview", Quality::Preview},
+                    {"production", Quality::Production}, {"final", Quality::Final});
 SHELLMPM_ENUM_WORDS(ShellVelocities, 2, {"per_shell", ShellVelocities::PerShell},
                     {"shared", ShellVelocities::Shared});
 SHELLMPM_ENUM_WORDS(ShotSettings::OnIntegrityFailure, 2,
