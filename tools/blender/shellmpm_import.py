@@ -38,6 +38,7 @@ bl_info = {
 PROP_RUN = "shellmpm_run"  # absolute path of the run folder
 PROP_PATTERN = "shellmpm_pattern"  # the shell's mesh pattern, relative to the run folder
 PROP_FRAMES = "shellmpm_frames"  # [first, last] frames of the run
+PROP_FPS = "shellmpm_fps"  # the run's frames per second
 PROP_LOADED = "shellmpm_loaded_frame"  # the frame whose positions the mesh holds
 
 # Scene coordinates (Y up) to Blender's (Z up): +90 degrees about X, (x, y, z) -> (x, -z, y),
@@ -254,35 +255,58 @@ def build_shell_mesh(name, frame_data):
     return mesh
 
 
-def update_shell_object(obj, frame):
-    """Loads the positions of `frame` (clamped to the run's frames) into the shell object's
-    mesh; returns the frame loaded, or None when the file is missing or does not match."""
-    first, last = (int(v) for v in obj[PROP_FRAMES])
-    frame = min(max(int(frame), first), last)
-    mesh = obj.data
-    if mesh.get(PROP_LOADED) == frame:
-        return frame
+def _frame_positions(obj, frame):
+    """The positions and velocities of the shell's PLY of `frame`, or None (reported) when
+    the file is missing or does not match the object."""
     path = frame_file(obj[PROP_RUN], obj[PROP_PATTERN], frame)
     if not os.path.isfile(path):
-        print(f"shellmpm: {path}: missing; '{obj.name}' keeps frame {mesh.get(PROP_LOADED)}")
+        print(f"shellmpm: {path}: missing; '{obj.name}' keeps frame {obj.data.get(PROP_LOADED)}")
         return None
     try:
         data = read_ply(path, faces=False)
     except ShellmpmError as e:
         print(f"shellmpm: {e}")
         return None
-    x = data["positions"]
-    if len(x) != len(mesh.vertices):
+    if len(data["positions"]) != len(obj.data.vertices):
         print(
-            f"shellmpm: {path}: {len(x)} vertices, but '{obj.name}' has {len(mesh.vertices)} "
-            "(caches keep one vertex count per shell); not loaded"
+            f"shellmpm: {path}: {len(data['positions'])} vertices, but '{obj.name}' has "
+            f"{len(obj.data.vertices)} (caches keep one vertex count per shell); not loaded"
         )
         return None
-    mesh.vertices.foreach_set("co", x.ravel())
+    return data
+
+
+def update_shell_object(obj, frame, subframe=0.0, fps=None):
+    """Loads the positions of `frame` (clamped to the run's frames) into the shell object's
+    mesh; returns the frame loaded, or None when the file is missing or does not match.
+    Between frames (`subframe` > 0: Cycles' motion blur steps) the positions move on along
+    the PLY's velocities for subframe / fps seconds when it has them (and `fps` is given),
+    else straight towards the next frame's."""
+    first, last = (int(v) for v in obj[PROP_FRAMES])
+    clamped = min(max(int(frame), first), last)
+    if clamped != int(frame) or clamped == last or subframe <= 0.0:
+        subframe = 0.0
+    frame = clamped
+    key = frame + subframe if subframe else frame
+    mesh = obj.data
+    if mesh.get(PROP_LOADED) == key:
+        return key
+    data = _frame_positions(obj, frame)
+    if data is None:
+        return None
+    x = data["positions"]
+    if subframe:
+        if data["velocities"] is not None and fps:
+            x = x + data["velocities"] * (subframe / fps)
+        else:
+            after = _frame_positions(obj, frame + 1)
+            if after is not None:
+                x = (1.0 - subframe) * x + subframe * after["positions"]
+    mesh.vertices.foreach_set("co", x.astype(np.float32).ravel())
     _set_velocities(mesh, data["velocities"])
     mesh.update()
-    mesh[PROP_LOADED] = frame
-    return frame
+    mesh[PROP_LOADED] = key
+    return key
 
 
 @persistent
@@ -290,7 +314,12 @@ def shellmpm_frame_change(scene, *_):
     """frame_change_pre handler: every shellmpm shell object in the scene follows the frame."""
     for obj in scene.objects:
         if obj.type == "MESH" and PROP_PATTERN in obj and PROP_RUN in obj:
-            update_shell_object(obj, scene.frame_current)
+            update_shell_object(
+                obj,
+                scene.frame_current,
+                scene.frame_subframe,
+                obj.get(PROP_FPS),
+            )
 
 
 def register_handler():
@@ -469,6 +498,7 @@ def import_run(
         obj[PROP_RUN] = rundir
         obj[PROP_PATTERN] = sh["pattern"]
         obj[PROP_FRAMES] = [first, last]
+        obj[PROP_FPS] = float(res["fps"])
         obj.parent = root
         mesh.materials.append(
             shell_material(
