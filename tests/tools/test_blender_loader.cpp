@@ -59,10 +59,10 @@ shell_materials:
 shells:
   - name: cloth
     material: cotton
-    geometry: {type: sheet, size: [0.5, 0.4], resolution: [6, 6]}
+    geometry: {type: sheet, size: [0.5, 0.4], resolution: [10, 8]}
     translate: [-0.1, 0.75, -0.2]
     rotate: [20, 0, 0]
-    pins: [{indices: [0, 6]}]
+    pins: [{indices: [0, 10]}]
 render:
   size: [160, 90]
   cameras:

@@ -516,8 +516,8 @@ def import_run(
         path = frame_file(rundir, dens["pattern"], first)
         if not os.path.isfile(path):
             raise ShellmpmError(f"{path}: missing (the run's first density volume)")
-        vol = bpy.data.volumes.load(path)
-        vol.name = f"{name}_density"
+        vol = bpy.data.volumes.new(f"{name}_density")
+        vol.filepath = path
         vol.is_sequence = True
         # Blender's file number = scene frame - frame_start + 1 + frame_offset.
         vol.frame_start = first
