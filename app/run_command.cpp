@@ -37,6 +37,8 @@ void write_manifest(const RunArgs& a, const Scene& scene) {
   m.frame_start = scene.shot.frame_start;
   m.frame_end = scene.shot.frame_end;
   write_run_manifest(scene.output.directory, m);
+  // The resolved block is added to the file the manifest writer made (its fields stay
+  // exactly as render/run_manifest.cpp writes and reads them).
   const std::string path = run_manifest_path(scene.output.directory);
   std::ifstream written(path, std::ios::binary);
   std::stringstream manifest;
