@@ -8,6 +8,8 @@
 #include "app/frame_range.h"
 #include "app/scene_loading.h"
 #include "app/stop_signals.h"
+#include "io/atomic_file.h"
+#include "io/run_resolved.h"
 #include "io/shot_runner.h"
 #include "render/preview_job.h"
 #include "render/run_manifest.h"
@@ -18,7 +20,9 @@ namespace shellmpm {
 namespace {
 
 /// run.json, which lets `shellmpm render OUTDIR` find the scene later (when the output
-/// folder cannot be made, run_shot reports it).
+/// folder cannot be made, run_shot reports it), with a "resolved" block beside the
+/// manifest's fields for tools that do not read YAML (io/run_resolved.h; the Blender
+/// loader in tools/blender).
 void write_manifest(const RunArgs& a, const Scene& scene) {
   std::error_code ec;
   std::filesystem::create_directories(scene.output.directory, ec);
@@ -33,6 +37,15 @@ void write_manifest(const RunArgs& a, const Scene& scene) {
   m.frame_start = scene.shot.frame_start;
   m.frame_end = scene.shot.frame_end;
   write_run_manifest(scene.output.directory, m);
+  // The resolved block is added to the file the manifest writer made (its fields stay
+  // exactly as render/run_manifest.cpp writes and reads them).
+  const std::string path = run_manifest_path(scene.output.directory);
+  std::ifstream written(path, std::ios::binary);
+  std::stringstream manifest;
+  manifest << written.rdbuf();
+  nlohmann::json j = nlohmann::json::parse(manifest.str());
+  j["resolved"] = resolved_run_settings(scene);
+  write_text_atomic(path, j.dump(2) + "\n");
 }
 
 /// The preview renderer of `run --preview` (render.preview), drawing each frame once written.
