@@ -5,8 +5,8 @@
 #include "io/available_memory.h"
 #include "io/scene_quality.h"
 #include "io/study/preset_errors.h"
-#include "sim/scene/scene_words.h"
 #include "sim/core/parallel.h"
+#include "sim/scene/scene_words.h"
 #include "sim/solver/shot_estimate.h"
 #include "sim/solver/solver.h"
 #include "sim/solver/stages/shell_guard.h"
@@ -141,8 +141,7 @@ void print_quality(const Scene& scene) {
     std::printf("; %s: %g particles per cell", src.name.c_str(), src.particles_per_cell);
   std::printf(" (keys the scene sets itself keep their values)\n");
   const std::string results = std::string(SHELLMPM_SOURCE_DIR) + "/docs/accuracy/results.json";
-  const std::vector<PresetMeasurement> m =
-      preset_measurements(results, q, nearest_problems(scene));
+  const std::vector<PresetMeasurement> m = preset_measurements(results, q, nearest_problems(scene));
   if (m.empty()) {
     std::printf("  no study results for this preset in %s (run `shellmpm study`)\n",
                 results.c_str());

@@ -21,8 +21,7 @@ void add_common(CLI::App* cmd, CommonArgs& a) {
   cmd->add_option("--threads", a.threads, "worker threads (0 = all cores; default: scene)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option_function<std::string>(
-         "--quality",
-         [&a](const std::string& q) { a.overrides.push_back("shot.quality=" + q); },
+         "--quality", [&a](const std::string& q) { a.overrides.push_back("shot.quality=" + q); },
          "accuracy preset: draft, preview, production or final (as shot.quality)")
       ->check(CLI::IsMember(words_of<Quality>()));
   cmd->add_flag_callback(

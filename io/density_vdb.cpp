@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "io/atomic_file.h"
+#include "io/vdb_axes.h"
 #include "sim/core/parallel.h"
 
 namespace shellmpm {
@@ -319,12 +320,13 @@ void write_density_vdb(const std::string& path, const DensityInput& in, const Vd
   openvdb::FloatGrid::Ptr density =
       make_grid<openvdb::FloatGrid>("density", 0.0f, xform, o, dens_leaves);
   density->setGridClass(openvdb::GRID_FOG_VOLUME);
-  openvdb::GridPtrVec grids{density};
+  // 6. In the output axes (a voxel permutation; nothing for Y up).
+  openvdb::GridPtrVec grids{scalar_grid_to_output_axes<openvdb::FloatGrid>(density, o.up_axis)};
   if (want_vel) {
     openvdb::Vec3SGrid::Ptr vel =
         make_grid<openvdb::Vec3SGrid>("vel", openvdb::Vec3s(0.0f), xform->copy(), o, vel_leaves);
     vel->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
-    grids.push_back(vel);
+    grids.push_back(vector_grid_to_output_axes(vel, o.up_axis));
   }
   openvdb::MetaMap file_meta;
   add_metadata(file_meta, o);

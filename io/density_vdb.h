@@ -7,6 +7,7 @@
 #include <string>
 
 #include "sim/core/types.h"
+#include "sim/scene/scene.h"
 
 namespace shellmpm {
 
@@ -26,6 +27,10 @@ struct VdbOptions {
   int frame = 1;             ///< "frame" metadata
   double time = 0.0;         ///< "time" metadata [s]
   std::string units = "m";   ///< "units" metadata
+  /// Axes of the file (output.up_axis). Z: the volume rasterized Y-up, then voxel (i, j, k)
+  /// moved to (i, -k, j) and `vel` values (x, y, z) turned to (x, -z, y) (io/vdb_axes.h):
+  /// an exact rotation; transform, voxel size and metadata unchanged.
+  UpAxis up_axis = UpAxis::Y;
 };
 
 /// Rasterizes particles into a fog volume and writes it atomically to `path`.

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace shellmpm {
 namespace {
@@ -133,18 +134,27 @@ void read_header(PlyFile& f) {
   f.remaining = file_size - static_cast<long long>(body);
 }
 
-/// The vertex element: float x, y, z (finite), and nx, ny, nz when all three are there.
+/// The vertex element: float x, y, z (finite), and nx, ny, nz / s, t / vx, vy, vz when all
+/// of a group are there.
 void read_vertices(PlyFile& f, const Element& e, PlyMesh& mesh) {
-  int ox = -1, oy = -1, oz = -1, onx = -1, ony = -1, onz = -1;
+  int ox = -1, oy = -1, oz = -1, onx = -1, ony = -1, onz = -1, os = -1, ot = -1;
+  int ovx = -1, ovy = -1, ovz = -1;
   for (const Property& p : e.props) {
     if (p.list) throw f.fail("list property in the vertex element");
     const bool fl = p.type == "float" || p.type == "float32";
-    if (p.name == "x" && fl) ox = p.offset;
-    if (p.name == "y" && fl) oy = p.offset;
-    if (p.name == "z" && fl) oz = p.offset;
-    if (p.name == "nx" && fl) onx = p.offset;
-    if (p.name == "ny" && fl) ony = p.offset;
-    if (p.name == "nz" && fl) onz = p.offset;
+    if (!fl) continue;
+    for (auto [name, offset] : {std::pair<const char*, int*>{"x", &ox},
+                                {"y", &oy},
+                                {"z", &oz},
+                                {"nx", &onx},
+                                {"ny", &ony},
+                                {"nz", &onz},
+                                {"s", &os},
+                                {"t", &ot},
+                                {"vx", &ovx},
+                                {"vy", &ovy},
+                                {"vz", &ovz}})
+      if (p.name == name) *offset = p.offset;
   }
   if (ox < 0 || oy < 0 || oz < 0) throw f.fail("the vertex element has no float x, y, z");
   const long long bytes = e.count * e.record;
@@ -156,9 +166,12 @@ void read_vertices(PlyFile& f, const Element& e, PlyMesh& mesh) {
   f.in.read(buf.data(), bytes);
   if (!f.in) throw f.fail("read error in the vertex data");
   f.remaining -= bytes;
-  const bool has_n = onx >= 0 && ony >= 0 && onz >= 0;
+  const bool has_n = onx >= 0 && ony >= 0 && onz >= 0, has_uv = os >= 0 && ot >= 0;
+  const bool has_v = ovx >= 0 && ovy >= 0 && ovz >= 0;
   mesh.positions.resize(static_cast<std::size_t>(e.count));
   if (has_n) mesh.normals.resize(static_cast<std::size_t>(e.count));
+  if (has_uv) mesh.uvs.resize(static_cast<std::size_t>(e.count));
+  if (has_v) mesh.velocities.resize(static_cast<std::size_t>(e.count));
   for (long long i = 0; i < e.count; ++i) {
     const char* r = buf.data() + i * e.record;
     float v[3];
@@ -173,6 +186,17 @@ void read_vertices(PlyFile& f, const Element& e, PlyMesh& mesh) {
       std::memcpy(&v[1], r + ony, 4);
       std::memcpy(&v[2], r + onz, 4);
       mesh.normals[static_cast<std::size_t>(i)] = Vec3f(v[0], v[1], v[2]);
+    }
+    if (has_uv) {
+      std::memcpy(&v[0], r + os, 4);
+      std::memcpy(&v[1], r + ot, 4);
+      mesh.uvs[static_cast<std::size_t>(i)] = Eigen::Vector2f(v[0], v[1]);
+    }
+    if (has_v) {
+      std::memcpy(&v[0], r + ovx, 4);
+      std::memcpy(&v[1], r + ovy, 4);
+      std::memcpy(&v[2], r + ovz, 4);
+      mesh.velocities[static_cast<std::size_t>(i)] = Vec3f(v[0], v[1], v[2]);
     }
   }
 }

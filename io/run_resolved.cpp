@@ -3,6 +3,7 @@
 #include <string>
 
 #include "io/shell_mesh_writer.h"
+#include "sim/scene/scene_words.h"
 
 namespace shellmpm {
 
@@ -29,7 +30,7 @@ nlohmann::json resolved_run_settings(const Scene& scene) {
   nlohmann::json j;
   j["fps"] = scene.shot.fps;
   j["frames"] = {scene.shot.frame_start, scene.shot.frame_end};
-  j["up_axis"] = "y";  // up_axis: becomes the scene's output.up_axis once OutputSettings has it
+  j["up_axis"] = word_of(scene.output.up_axis);
   j["units"] = scene.shot.units;
   j["size"] = {rs.width, rs.height};
   const bool bulk = !scene.sources.empty();

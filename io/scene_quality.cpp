@@ -61,8 +61,7 @@ DocNode scalar(const std::string& text, const Origin& o) {
 }
 
 /// Sets map.key to `text` when the key is absent.
-void set_if_absent(DocNode& map, const std::string& key, const std::string& text,
-                   const Origin& o) {
+void set_if_absent(DocNode& map, const std::string& key, const std::string& text, const Origin& o) {
   if (map.kind != DocNode::Kind::Map || entry(map, key) != nullptr) return;
   map.entries.push_back({key, o, scalar(text, o)});
 }
@@ -111,7 +110,8 @@ void apply_quality(DocNode& root) {
       set_if_absent(m, "contact_samples", std::to_string(p.contact_samples), o);
     }
   if (DocNode* srcs = entry(root, "sources"); srcs && srcs->kind == DocNode::Kind::List)
-    for (DocNode& s : srcs->items) set_if_absent(s, "particles_per_cell", text_of(p.particles_per_cell), o);
+    for (DocNode& s : srcs->items)
+      set_if_absent(s, "particles_per_cell", text_of(p.particles_per_cell), o);
   if (DocNode* shells = entry(root, "shells"); shells && shells->kind == DocNode::Kind::List)
     for (DocNode& sh : shells->items) {
       DocNode* g = entry(sh, "geometry");

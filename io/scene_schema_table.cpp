@@ -468,6 +468,7 @@ std::vector<KeySpec> build_schema() {
                             "shells; ends in `.ply`, `.obj` or `.glb` as `shell_format` says; ") +
                 kOutputFile),
       Spec("output.shell_format", T::Enum).to(&OutputSettings::shell_format).def("ply"),
+      Spec("output.up_axis", T::Enum).to(&OutputSettings::up_axis).def("y"),
       // render (previews; nothing here changes the simulation)
       Spec("render.preview", T::Bool).to(&RenderSettings::preview).def("false"),
       Spec("render.renderer", T::Enum).to(&RenderSettings::renderer).def("raster"),

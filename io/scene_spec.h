@@ -1,9 +1,9 @@
 // The builder the schema table (io/scene_schema_table.cpp) is written with: one Spec per
 // key, reading like the documentation, binding the struct field the value fills.
 #pragma once
-#include <optional>
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <type_traits>

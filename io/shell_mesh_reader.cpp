@@ -94,24 +94,33 @@ ShellMesh read_shell_mesh(const std::string& path, const std::string& where) {
       throw detail::user_error_at(where, os.str());
     }
 
-  // One control point per position: the first occurrence wins (and keeps its UV).
+  // One control point per position, numbered in order of first occurrence; and one UV
+  // entry per distinct (control point, UV) pair, numbered the same way, so that a mesh
+  // without seams has uv index == control point index.
   ShellMesh out;
-  std::vector<int> remap(in.vertices.size());
+  const bool has_uvs = !in.uvs.empty();
+  std::vector<int> remap(in.vertices.size()), uv_remap(has_uvs ? in.vertices.size() : 0);
   std::unordered_map<PositionKey, int, PositionHash> first_at;
+  std::unordered_map<PositionKey, int, PositionHash> uv_at;  // (point, u, v) bits -> uv index
   first_at.reserve(in.vertices.size());
   for (std::size_t v = 0; v < in.vertices.size(); ++v) {
     const auto [it, inserted] =
         first_at.emplace(key_of(in.vertices[v]), static_cast<int>(out.vertices.size()));
-    if (inserted) {
-      out.vertices.push_back(in.vertices[v]);
-      if (!in.uvs.empty()) out.uvs.push_back(in.uvs[v]);
-    }
+    if (inserted) out.vertices.push_back(in.vertices[v]);
     remap[v] = it->second;
+    if (!has_uvs) continue;
+    PositionKey k = key_of(Vec3d(in.uvs[v].x(), in.uvs[v].y(), 0.0));
+    k.bits[2] = static_cast<std::uint64_t>(it->second);
+    const auto [u, uv_new] = uv_at.emplace(k, static_cast<int>(out.uvs.size()));
+    if (uv_new) out.uvs.push_back(in.uvs[v]);
+    uv_remap[v] = u->second;
   }
   out.triangles.reserve(in.triangles.size());
+  if (has_uvs) out.uv_triangles.reserve(in.triangles.size());
   for (std::size_t t = 0; t < in.triangles.size(); ++t) {
-    const Eigen::Vector3i f(remap[in.triangles[t][0]], remap[in.triangles[t][1]],
-                            remap[in.triangles[t][2]]);
+    const Eigen::Vector3i& ft = in.triangles[t];
+    const Eigen::Vector3i f(remap[ft[0]], remap[ft[1]], remap[ft[2]]);
+    if (has_uvs) out.uv_triangles.emplace_back(uv_remap[ft[0]], uv_remap[ft[1]], uv_remap[ft[2]]);
     if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) {
       std::ostringstream os;
       os << "mesh '" << path << "': triangle " << t

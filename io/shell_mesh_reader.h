@@ -16,9 +16,11 @@ namespace shellmpm {
 ///   merged, also across meshes: a shell needs one control point per geometric
 ///   position, so hard edges and UV seams do not split it and separately stored parts
 ///   that share boundary vertices are stitched. The first occurrence is kept (control
-///   points are numbered in order of first occurrence) and carries its UV: across a
-///   UV seam the control point, and so every written frame, has the UV of the first
-///   vertex read there. Triangles are remapped.
+///   points are numbered in order of first occurrence). Triangles are remapped.
+/// - UVs stay per corner: `uvs` holds one entry per distinct (control point, UV) pair
+///   (exactly equal values; numbered in order of first occurrence) and `uv_triangles`
+///   each corner's entry, so a control point on a UV seam has several entries and the
+///   output meshes split there (LimitMesh). Without seams uv_triangles == triangles.
 /// - Groups: the name of every assimp mesh and of every node (OBJ `o` and `g` names,
 ///   glTF node and mesh names, ...) becomes a group holding the sorted unique control
 ///   points of its triangles (a node's group includes its children's meshes). Equal

@@ -12,6 +12,7 @@
 
 #include "io/atomic_file.h"
 #include "sim/core/check.h"
+#include "sim/scene/output_axes.h"
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
               "the PLY and GLB writers copy little-endian memory as is");
@@ -41,6 +42,7 @@ struct Attributes {
   std::vector<std::int32_t> indices;  // 3 per triangle
 };
 
+/// The frame's float data in the simulation's axes (Y up); see to_file_axes.
 Attributes gather(const MeshFrame& m) {
   const std::size_t n = m.num_vertices;
   Attributes a;
@@ -90,6 +92,13 @@ Attributes gather(const MeshFrame& m) {
   return a;
 }
 
+/// Turns the vectors of `a` into the axes `up` (exact: a permutation and a sign).
+void to_file_axes(Attributes& a, UpAxis up) {
+  to_output_axes(a.positions.data(), a.positions.size() / 3, up);
+  to_output_axes(a.normals.data(), a.normals.size() / 3, up);
+  to_output_axes(a.velocities.data(), a.velocities.size() / 3, up);
+}
+
 template <class T>
 void append_raw(std::string& out, const T* data, std::size_t count) {
   out.append(reinterpret_cast<const char*>(data), count * sizeof(T));
@@ -130,6 +139,7 @@ std::string encode_ply(const MeshFrame& m, const Attributes& a) {
   if (!m.name.empty()) header += "comment name " + single_token(m.name) + "\n";
   header += "comment frame " + std::to_string(m.frame) + "\n";
   header += "comment time " + format_double(m.time) + "\n";
+  if (mesh_file_up_axis(MeshFormat::Ply, m.up_axis) == UpAxis::Z) header += "comment up_axis z\n";
   header += "element vertex " + std::to_string(n) + "\n";
   header += "property float x\nproperty float y\nproperty float z\n";
   header += "property float nx\nproperty float ny\nproperty float nz\n";
@@ -171,6 +181,7 @@ std::string encode_obj(const MeshFrame& m, const Attributes& a) {
   out += uv ? ", vt" : "";
   out += " per vertex, in simulation order\n";
   out += "# frame " + std::to_string(m.frame) + " time " + format_double(m.time) + "\n";
+  if (mesh_file_up_axis(MeshFormat::Obj, m.up_axis) == UpAxis::Z) out += "# up_axis z\n";
   if (!m.name.empty()) out += "o " + single_token(m.name) + "\n";
   const auto lines = [&](const char* tag, const std::vector<float>& values, int dim) {
     for (std::size_t v = 0; v < n; ++v) {
@@ -335,7 +346,8 @@ void write_shell_mesh(const std::string& path, const MeshFrame& mesh, MeshFormat
   SHELLMPM_CHECK(mesh.num_vertices <= 0x7fffffffu && 3 * mesh.num_triangles <= 0x7fffffffu,
                  "mesh too large: " << mesh.num_vertices << " vertices, " << mesh.num_triangles
                                     << " triangles");
-  const Attributes a = gather(mesh);
+  Attributes a = gather(mesh);
+  to_file_axes(a, mesh_file_up_axis(format, mesh.up_axis));
   std::string bytes;
   switch (format) {
     case MeshFormat::Ply:

@@ -9,7 +9,8 @@
 // reorders them; only "plyb" keeps the order, but copying the scene costs time.
 // The writers below emit exactly `num_vertices` vertices in the given order:
 //   - Ply: binary little-endian PLY. vertex: float x y z nx ny nz [s t] [vx vy vz];
-//     face: list uchar int vertex_indices. Comments carry name, frame and time.
+//     face: list uchar int vertex_indices. Comments carry name, frame and time (and
+//     "up_axis z" when written Z-up).
 //     Velocities use the particle cache's names (io/particle_cache.h): PLY properties
 //     are scalars (Blender 4.1+ imports each extra one as a float attribute); a
 //     wrangle joins them into Houdini's vector `v` (v@v = set(f@vx, f@vy, f@vz)).
@@ -56,6 +57,11 @@ struct MeshFrame {
   int frame = 0;      ///< frame number, recorded in the file
   double time = 0.0;  ///< simulation time [s], recorded in the file
   std::string name;   ///< object name (OBJ "o", glTF node and mesh name)
+  /// The axes to write in (output.up_axis): positions, normals and velocities are turned
+  /// by to_output_axes (sim/scene/output_axes.h) after rounding to float, so the file is
+  /// an exact rotation of the Y-up one. GLB ignores it (mesh_file_up_axis,
+  /// sim/scene/output_axes.h).
+  UpAxis up_axis = UpAxis::Y;
 };
 
 /// Writes `mesh` to `path` atomically (io/atomic_file.h) in `format`, with exactly

@@ -31,10 +31,11 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
     vo.frame = frame;
     vo.time = solver.time();
     vo.units = scene.shot.units;
+    vo.up_axis = o.up_axis;
     write_density_vdb(frame_path(o.directory, o.density_pattern, frame), in, vo);
   }
   if (o.particles && !scene.sources.empty())
-    write_particle_ply(frame_path(o.directory, o.particles_pattern, frame), p);
+    write_particle_ply(frame_path(o.directory, o.particles_pattern, frame), p, o.up_axis);
   const MeshFormat format = o.shell_format;
   std::vector<Vec3> pos, nrm, vel;
   for (const auto& sh : solver.shells()) {
@@ -55,6 +56,7 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
     mf.frame = frame;
     mf.time = solver.time();
     mf.name = sh->name();
+    mf.up_axis = o.up_axis;
     std::string pattern = o.shell_pattern;
     const auto at = pattern.find("{name}");
     if (at != std::string::npos) pattern.replace(at, 6, sh->name());

@@ -11,11 +11,14 @@
 #include "io/mesh_reader.h"
 #include "io/ply_reader.h"
 #include "io/user_error.h"
+#include "io/vdb_axes.h"
+#include "render/cache_axes.h"
 #include "render/particle_culling.h"
 #include "render/tessellate.h"
 #include "sim/collider/collider.h"
 #include "sim/collider/shape_sdf.h"
 #include "sim/core/check.h"
+#include "sim/scene/output_axes.h"
 #include "sim/scene/scene_words.h"
 
 namespace shellmpm {
@@ -319,6 +322,7 @@ RenderMesh SceneAssembler::read_shell(const ShellDesc& sh, int frame) const {
       throw CacheError(path, e.message);
     }
   }
+  mesh_from_output_axes(m, mesh_file_up_axis(scene_.output.shell_format, scene_.output.up_axis));
   if (m.triangles.empty()) throw CacheError(path, "has no triangles");
   if (m.normals.size() != m.positions.size()) m.normals = vertex_normals(m.positions, m.triangles);
   for (Vec3f& n : m.normals) {
@@ -364,7 +368,8 @@ PreviewScene SceneAssembler::assemble(int frame) const {
   // Bulk material.
   if (bulk_ == BulkDraw::Volume || bulk_ == BulkDraw::Surface) {
     const std::string path = frame_path(outdir_, scene_.output.density_pattern, frame);
-    openvdb::FloatGrid::Ptr grid = read_density_grid(path);
+    const openvdb::FloatGrid::Ptr grid = scalar_grid_from_output_axes<openvdb::FloatGrid>(
+        read_density_grid(path), scene_.output.up_axis);
     if (bulk_ == BulkDraw::Surface) {
       RenderMesh m = iso_surface(*grid, rs.iso_value);
       m.front = m.back = bulk_color_;
@@ -386,6 +391,7 @@ PreviewScene SceneAssembler::assemble(int frame) const {
     if (!fs::exists(path, ec)) throw CacheError(path, "missing (the run did not write this frame)");
     try {
       ps.particles.positions = read_ply(path).positions;
+      points_from_output_axes(ps.particles.positions, scene_.output.up_axis);
     } catch (const std::runtime_error& e) {
       throw CacheError(path, std::string(e.what()).substr(path.size() + 2));
     }

@@ -12,10 +12,10 @@ std::vector<std::string> nearest_problems(const Scene& scene) {
   std::vector<std::string> out;
   bool contact_shells = false, lone_shells = false;
   for (const ShellDesc& s : scene.shells) {
-    const bool contact = s.contact == ShellDesc::Contact::On ||
-                         (s.contact == ShellDesc::Contact::Auto &&
-                          (!scene.colliders.empty() || !scene.sources.empty() ||
-                           scene.shells.size() > 1));
+    const bool contact =
+        s.contact == ShellDesc::Contact::On ||
+        (s.contact == ShellDesc::Contact::Auto &&
+         (!scene.colliders.empty() || !scene.sources.empty() || scene.shells.size() > 1));
     (contact ? contact_shells : lone_shells) = true;
   }
   if (contact_shells) {
@@ -34,8 +34,7 @@ std::vector<std::string> nearest_problems(const Scene& scene) {
   return out;
 }
 
-std::vector<PresetMeasurement> preset_measurements(const std::string& results_json,
-                                                   Quality quality,
+std::vector<PresetMeasurement> preset_measurements(const std::string& results_json, Quality quality,
                                                    const std::vector<std::string>& problems) {
   std::vector<PresetMeasurement> out;
   std::ifstream in(results_json);

@@ -13,7 +13,8 @@ namespace shellmpm {
 struct PresetMeasurement {
   std::string problem;  ///< reference problem name
   std::string error;    ///< "-1.2%" or "-0.0003 m"
-  double cost_vs_production = 0;  ///< this preset's cost / production's on that problem (0: unknown)
+  double cost_vs_production =
+      0;  ///< this preset's cost / production's on that problem (0: unknown)
 };
 
 /// The reference problems that stand nearest to what the scene holds.
@@ -21,8 +22,7 @@ std::vector<std::string> nearest_problems(const Scene& scene);
 
 /// The preset's measurements on `problems` from the study results at `results_json`.
 /// Empty when the file is missing or holds no run of that preset.
-std::vector<PresetMeasurement> preset_measurements(const std::string& results_json,
-                                                   Quality quality,
+std::vector<PresetMeasurement> preset_measurements(const std::string& results_json, Quality quality,
                                                    const std::vector<std::string>& problems);
 
 }  // namespace shellmpm

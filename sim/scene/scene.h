@@ -230,6 +230,11 @@ struct PrerollSettings {
 /// The file format of the shell meshes written per frame.
 enum class MeshFormat { Ply, Obj, Glb };
 
+/// The up axis of the caches a run writes (output.up_axis). The simulation is always
+/// Y-up; Z writes every cache rotated by +90 degrees about X, (x, y, z) -> (x, -z, y)
+/// (sim/scene/output_axes.h), except glTF meshes, which glTF 2.0 defines as Y-up.
+enum class UpAxis { Y, Z };
+
 /// What to write.
 struct OutputSettings {
   std::string directory = "out";
@@ -247,6 +252,7 @@ struct OutputSettings {
   /// shell_format (".glb" for glb) and refuses a pattern that names another format.
   std::string shell_pattern = "{name}.####.ply";
   MeshFormat shell_format = MeshFormat::Ply;  ///< ply (binary) | obj | glb
+  UpAxis up_axis = UpAxis::Y;                 ///< axes of the caches (not of the simulation)
 };
 
 /// A preview camera (render.cameras[]): looks from `position` at `target`.

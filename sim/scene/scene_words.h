@@ -56,6 +56,7 @@ SHELLMPM_ENUM_WORDS(PrerollSettings::Method, 2, {"static", PrerollSettings::Meth
                     {"dynamic", PrerollSettings::Method::Dynamic});
 SHELLMPM_ENUM_WORDS(MeshFormat, 3, {"ply", MeshFormat::Ply}, {"obj", MeshFormat::Obj},
                     {"glb", MeshFormat::Glb});
+SHELLMPM_ENUM_WORDS(UpAxis, 2, {"y", UpAxis::Y}, {"z", UpAxis::Z});
 SHELLMPM_ENUM_WORDS(RendererKind, 2, {"raster", RendererKind::Raster},
                     {"raytrace", RendererKind::Raytrace});
 SHELLMPM_ENUM_WORDS(BulkDraw, 5, {"auto", BulkDraw::Auto}, {"volume", BulkDraw::Volume},

@@ -23,6 +23,7 @@ ShellMesh make_sheet(double size_x, double size_z, int nx, int nz) {
       m.triangles.emplace_back(id(i, j), id(i, j + 1), id(i + 1, j));
       m.triangles.emplace_back(id(i + 1, j), id(i, j + 1), id(i + 1, j + 1));
     }
+  m.uv_triangles = m.triangles;  // one UV per vertex
   return m;
 }
 
@@ -47,6 +48,7 @@ ShellMesh make_cylinder(double radius, double height, double angle_deg, int n_ar
       m.triangles.emplace_back(id(i, j), id(i + 1, j), id(i, j + 1));
       m.triangles.emplace_back(id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
     }
+  m.uv_triangles = m.triangles;  // one UV per vertex
   return m;
 }
 
@@ -88,6 +90,7 @@ ShellMesh make_sphere(double radius, int subdivisions) {
     m.uvs.emplace_back(0.5 + std::atan2(x.z(), x.x()) / (2 * M_PI), 0.5 + std::asin(x.y()) / M_PI);
   }
   m.triangles = t;
+  m.uv_triangles = t;  // one UV per vertex
   return m;
 }
 

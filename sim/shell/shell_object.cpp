@@ -90,7 +90,8 @@ ShellObject::ShellObject(const ShellDesc& desc, const ShellMaterialDesc& mat, Sh
   quadrature_points(*basis_, static_cast<int>(tris_.size()), mat.quadrature_inplane, pts, weights);
   kl_ = std::make_unique<KirchhoffLoveShell>(std::move(pts), std::move(weights), rest, mat,
                                              mat.quadrature_thickness);
-  limit_ = std::make_unique<LimitMesh>(*basis_, tris_, rest_mesh.uvs, desc.output_refine);
+  limit_ = std::make_unique<LimitMesh>(*basis_, tris_, rest_mesh.uvs, rest_mesh.uv_triangles,
+                                       desc.output_refine);
   mass = kl_->lumped_masses(rest.size());
   x.resize(nv);
   v.assign(nv, desc.velocity.cast<Real>());

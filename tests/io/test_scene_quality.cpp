@@ -6,6 +6,7 @@
 #include "io/scene_quality.h"
 #include "io/scene_reader.h"
 #include "io/user_error.h"
+#include "sim/scene/scene_words.h"
 
 using namespace shellmpm;
 
@@ -35,11 +36,12 @@ TEST_CASE("no quality: the scene as written", "[scene][quality]") {
   CHECK(s.shot.cfl == 0.3);
 }
 
-TEST_CASE("quality presets scale dx and sheet resolution and fill unset knobs", "[scene][quality]") {
+TEST_CASE("quality presets scale dx and sheet resolution and fill unset knobs",
+          "[scene][quality]") {
   for (Quality q : {Quality::Draft, Quality::Preview, Quality::Production, Quality::Final}) {
     const QualityPreset p = quality_preset(q);
-    const Scene s = parse_scene(scene_text("", ""), "q.yaml",
-                                {"shot.quality=" + std::string(word_of(q))});
+    const Scene s =
+        parse_scene(scene_text("", ""), "q.yaml", {"shot.quality=" + std::string(word_of(q))});
     CAPTURE(word_of(q));
     REQUIRE(s.shot.quality == q);
     CHECK(s.shot.dx == Approx(0.02 * p.dx_factor));
@@ -59,8 +61,9 @@ TEST_CASE("quality presets scale dx and sheet resolution and fill unset knobs", 
 }
 
 TEST_CASE("keys the scene or --set gives win over the preset", "[scene][quality]") {
-  const Scene s = parse_scene(scene_text(", cfl: 0.25, quality: draft", ", quadrature_thickness: 4"),
-                              "q.yaml", {"sources[0].particles_per_cell=27"});
+  const Scene s =
+      parse_scene(scene_text(", cfl: 0.25, quality: draft", ", quadrature_thickness: 4"), "q.yaml",
+                  {"sources[0].particles_per_cell=27"});
   CHECK(s.shot.cfl == 0.25);
   CHECK(s.shell_materials[0].quadrature_thickness == 4);
   CHECK(s.sources[0].particles_per_cell == 27);

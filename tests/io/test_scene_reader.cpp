@@ -1003,6 +1003,21 @@ TEST_CASE(
                {"must end in '.glb' for output.shell_format glb"}, {"output.shell_format=glb"});
 }
 
+TEST_CASE("output.up_axis: y by default, z when asked, anything else refused at the key",
+          "[scene][axes]") {
+  CHECK(parse_scene(kHead, "scenes/ok.yaml").output.up_axis == UpAxis::Y);
+  CHECK(parse_scene(kHead + "output:\n  up_axis: z\n", "scenes/ok.yaml").output.up_axis ==
+        UpAxis::Z);
+  CHECK(parse_scene(kHead, "scenes/ok.yaml", {"output.up_axis=z"}).output.up_axis == UpAxis::Z);
+  // GLB with Z up is accepted: glTF meshes stay Y-up by definition, the other caches turn.
+  CHECK(parse_scene(kHead + "output:\n  up_axis: z\n  shell_format: glb\n", "scenes/ok.yaml")
+            .output.up_axis == UpAxis::Z);
+  expect_override_error(kHead, "output.up_axis=x", "output.up_axis",
+                        {"expected one of y, z, got 'x'"});
+  expect_error(kHead + "output:\n  up_axis: Z\n", 6, "output.up_axis",
+               {"expected one of y, z, got 'Z'"});
+}
+
 TEST_CASE("docs/scene-format.md documents exactly the schema", "[scene]") {
   std::ifstream in(kSource + "/docs/scene-format.md");
   REQUIRE(in);

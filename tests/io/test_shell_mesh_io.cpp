@@ -443,7 +443,7 @@ TEST_CASE("read_shell_mesh turns OBJ o/g names into vertex groups", "[shellmesh]
   CHECK(m2.groups.at("hem").size() == 3);
 }
 
-TEST_CASE("read_shell_mesh merges a UV-seamed cube to 8 control points, first UV kept",
+TEST_CASE("read_shell_mesh merges a UV-seamed cube to 8 control points, UVs kept per corner",
           "[shellmesh]") {
   TempDir dir("shellmesh_cube");
   // Unit cube, each face with its own 4 UVs and its own normal: assimp's joining keeps
@@ -470,7 +470,9 @@ TEST_CASE("read_shell_mesh merges a UV-seamed cube to 8 control points, first UV
   const std::string path = dir.write("cube.obj", s);
   const ShellMesh m = read_shell_mesh(path, "scene.yaml");
   REQUIRE(m.vertices.size() == 8);
-  REQUIRE(m.uvs.size() == 8);
+  // Every corner of the cube is on three faces with three different UVs: 24 UV entries.
+  REQUIRE(m.uvs.size() == 24);
+  REQUIRE(m.uv_triangles.size() == 12);
   REQUIRE(m.triangles.size() == 12);
   std::set<std::tuple<double, double, double>> corners;
   for (const auto& v : m.vertices) corners.emplace(v.x(), v.y(), v.z());
@@ -484,26 +486,26 @@ TEST_CASE("read_shell_mesh merges a UV-seamed cube to 8 control points, first UV
     CHECK(count == 1);
     CHECK(directed.count({e.second, e.first}) == 1);
   }
-  // The first vertex read is the first corner of the first face (v 2 = (0.5,-0.5,-0.5)
-  // with vt 1 = (0, 0.5)); its control point keeps that UV, not a later face's.
-  REQUIRE(m.vertices[0] == Vec3d(0.5, -0.5, -0.5));
-  CHECK(m.uvs[0].x() == Approx(0.0).margin(1e-6));
-  CHECK(m.uvs[0].y() == Approx(0.5).margin(1e-6));
-  // Every control point's UV is the UV of its first corner in file order.
-  for (std::size_t v = 0; v < 8; ++v) {
-    bool found = false;
-    for (int f = 0; f < 6 && !found; ++f)
-      for (int k = 0; k < 4 && !found; ++k) {
-        const int i = faces[f][k] - 1;
-        const Vec3d p((i & 1) ? 0.5 : -0.5, (i & 2) ? 0.5 : -0.5, (i & 4) ? 0.5 : -0.5);
-        if (p != m.vertices[v]) continue;
-        found = true;
-        INFO("control point " << v);
-        CHECK(m.uvs[v].x() == Approx(0.1 * f + 0.01 * k).margin(1e-6));
-        CHECK(m.uvs[v].y() == Approx(0.5 + 0.1 * k).margin(1e-6));
+  // Every triangle corner keeps its face's UV: triangulated quad f holds triangles 2f and
+  // 2f + 1; each corner is the quad corner at its position.
+  for (int f = 0; f < 6; ++f)
+    for (int half = 0; half < 2; ++half) {
+      const Eigen::Vector3i& t = m.triangles[2 * f + half];
+      const Eigen::Vector3i& ut = m.uv_triangles[2 * f + half];
+      for (int c = 0; c < 3; ++c) {
+        int quad_corner = -1;
+        for (int k = 0; k < 4; ++k) {
+          const int i = faces[f][k] - 1;
+          if (m.vertices[t[c]] ==
+              Vec3d((i & 1) ? 0.5 : -0.5, (i & 2) ? 0.5 : -0.5, (i & 4) ? 0.5 : -0.5))
+            quad_corner = k;
+        }
+        INFO("face " << f << " triangle " << half << " corner " << c);
+        REQUIRE(quad_corner >= 0);
+        CHECK(m.uvs[ut[c]].x() == Approx(0.1 * f + 0.01 * quad_corner).margin(1e-6));
+        CHECK(m.uvs[ut[c]].y() == Approx(0.5 + 0.1 * quad_corner).margin(1e-6));
       }
-    CHECK(found);
-  }
+    }
 }
 
 TEST_CASE("read_shell_mesh reads back a written frame", "[shellmesh]") {
@@ -577,5 +579,67 @@ TEST_CASE("write_shell_mesh timing for a 100k-vertex mesh", "[shellmesh][timing]
          << ": wrote " << g.positions.size() << " vertices, " << g.triangles.size()
          << " triangles in " << s << " s (" << fs::file_size(path) / 1e6 << " MB)");
     CHECK(fs::file_size(path) > 0);
+  }
+}
+
+TEST_CASE("output.up_axis z: PLY and OBJ turned (x, y, z) -> (x, -z, y) exactly, GLB Y-up",
+          "[shellmesh][axes]") {
+  TempDir dir("shellmesh_up_axis");
+  const Grid g(5, 4);
+  const std::size_t n = g.positions.size();
+  const std::vector<Vec3> vel = grid_velocities(g);
+  for (const bool given_normals : {true, false}) {
+    INFO("normals given " << given_normals);
+    MeshFrame f = g.frame(given_normals, true);
+    f.velocities = vel.data();
+    const std::string y_ply = dir.file("y.ply"), z_ply = dir.file("z.ply");
+    write_shell_mesh(y_ply, f, MeshFormat::Ply);
+    f.up_axis = UpAxis::Z;
+    write_shell_mesh(z_ply, f, MeshFormat::Ply);
+    const PlyMesh y = read_ply(y_ply), z = read_ply(z_ply);
+    REQUIRE(z.positions.size() == n);
+    REQUIRE(z.normals.size() == n);
+    REQUIRE(z.velocities.size() == n);
+    CHECK(contains(file_bytes(z_ply), "comment up_axis z\n"));
+    CHECK(!contains(file_bytes(y_ply), "up_axis"));
+    for (std::size_t v = 0; v < n; ++v) {
+      INFO("vertex " << v);
+      // A known point: the float of the simulation's (x, y, z), turned.
+      const Vec3f p = g.positions[v].cast<float>();
+      CHECK(z.positions[v] == Vec3f(p.x(), -p.z(), p.y()));
+      CHECK(y.positions[v] == p);
+      const Vec3f u = vel[v].cast<float>();
+      CHECK(z.velocities[v] == Vec3f(u.x(), -u.z(), u.y()));
+      CHECK(z.normals[v] == Vec3f(y.normals[v].x(), -y.normals[v].z(), y.normals[v].y()));
+      CHECK(z.uvs[v] == y.uvs[v]);
+    }
+    CHECK(z.triangles == y.triangles);
+
+    // OBJ: the same through assimp (one vertex per face corner, in face order).
+    f.up_axis = UpAxis::Y;
+    write_shell_mesh(dir.file("y.obj"), f, MeshFormat::Obj);
+    f.up_axis = UpAxis::Z;
+    write_shell_mesh(dir.file("z.obj"), f, MeshFormat::Obj);
+    Assimp::Importer iy, iz;
+    const aiMesh* my = read_raw(iy, dir.file("y.obj"))->mMeshes[0];
+    const aiMesh* mz = read_raw(iz, dir.file("z.obj"))->mMeshes[0];
+    REQUIRE(my->mNumVertices == mz->mNumVertices);
+    for (unsigned v = 0; v < my->mNumVertices; ++v) {
+      const aiVector3D a = my->mVertices[v], b = mz->mVertices[v];
+      CHECK(b.x == a.x);
+      CHECK(b.y == -a.z);
+      CHECK(b.z == a.y);
+      const aiVector3D na = my->mNormals[v], nb = mz->mNormals[v];
+      CHECK(nb.x == na.x);
+      CHECK(nb.y == -na.z);
+      CHECK(nb.z == na.y);
+    }
+
+    // GLB: glTF is Y-up by definition; up_axis does not change a byte.
+    f.up_axis = UpAxis::Y;
+    write_shell_mesh(dir.file("y.glb"), f, MeshFormat::Glb);
+    f.up_axis = UpAxis::Z;
+    write_shell_mesh(dir.file("z.glb"), f, MeshFormat::Glb);
+    CHECK(file_bytes(dir.file("y.glb")) == file_bytes(dir.file("z.glb")));
   }
 }

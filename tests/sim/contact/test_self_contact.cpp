@@ -36,6 +36,7 @@ Scene fold_on_slope(double th_deg, double mu, bool folded, bool fold_fields = tr
   for (Eigen::Vector3i t : top.triangles) {
     if (folded) std::swap(t[1], t[2]);
     mesh.triangles.push_back(t + Eigen::Vector3i::Constant(off));
+    mesh.uv_triangles.push_back(t + Eigen::Vector3i::Constant(off));  // one UV per vertex
   }
   ShellDesc d;
   d.name = "cloth";
