@@ -140,8 +140,13 @@ void print_quality(const Scene& scene) {
   for (const SourceDesc& src : scene.sources)
     std::printf("; %s: %g particles per cell", src.name.c_str(), src.particles_per_cell);
   std::printf(" (keys the scene sets itself keep their values)\n");
-  const std::string results = std::string(SHELLMPM_SOURCE_DIR) + "/docs/accuracy/results.json";
-  const std::vector<PresetMeasurement> m = preset_measurements(results, q, nearest_problems(scene));
+  // The full study's results, or a presets-only study's (`study --sweep "quality preset"`).
+  std::string results = std::string(SHELLMPM_SOURCE_DIR) + "/docs/accuracy/results.json";
+  std::vector<PresetMeasurement> m = preset_measurements(results, q, nearest_problems(scene));
+  if (m.empty()) {
+    results = std::string(SHELLMPM_SOURCE_DIR) + "/docs/accuracy/presets/results.json";
+    m = preset_measurements(results, q, nearest_problems(scene));
+  }
   if (m.empty()) {
     std::printf("  no study results for this preset in %s (run `shellmpm study`)\n",
                 results.c_str());

@@ -46,6 +46,7 @@ struct RenderArgs {
 /// `shellmpm study`: the accuracy-vs-time study over the reference problems.
 struct StudyArgs {
   std::vector<std::string> suites;  ///< problem names, or "all"
+  std::vector<std::string> sweeps;  ///< sweep names to run; empty: all
   double budget = 3600;             ///< [s]
   std::string output = "out/study";
   int threads = 0;

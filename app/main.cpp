@@ -89,6 +89,10 @@ int main(int argc, char** argv) {
       ->add_option("--suite", study.suites,
                    "reference problems to run (names, or all; repeatable; default all)")
       ->take_all();
+  study_cmd
+      ->add_option("--sweep", study.sweeps,
+                   "sweeps to run, by name (e.g. \"quality preset\"; repeatable; default all)")
+      ->take_all();
   study_cmd->add_option("--budget", study.budget, "no run starts after this many seconds")
       ->check(CLI::PositiveNumber);
   study_cmd->add_option("--output,-o", study.output, "results folder (default out/study)");

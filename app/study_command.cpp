@@ -17,6 +17,7 @@ int study_command(const StudyArgs& a) {
   o.scenes_dir = a.scenes.empty() ? std::string(SHELLMPM_SOURCE_DIR) + "/scenes/study" : a.scenes;
   o.output = a.output;
   o.problems = a.suites;
+  o.sweeps = a.sweeps;
   o.threads = a.threads;
   o.budget_seconds = a.budget;
   o.quick = a.quick;

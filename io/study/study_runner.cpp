@@ -1,5 +1,6 @@
 #include "io/study/study_runner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -165,6 +166,9 @@ StudyResults run_study(const StudyOptions& opt) {
     for (std::size_t si = 0; si < p.sweeps.size(); ++si) {
       if (opt.quick && si > 0) break;
       const StudySweep& sw = p.sweeps[si];
+      if (!opt.sweeps.empty() &&
+          std::find(opt.sweeps.begin(), opt.sweeps.end(), sw.name) == opt.sweeps.end())
+        continue;
       StudySweepResult swr;
       swr.name = sw.name;
       swr.varied = sw.varied;

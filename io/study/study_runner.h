@@ -22,6 +22,7 @@ struct StudyOptions {
   std::vector<std::string> problems;  ///< names to run; empty: all
   int threads = 0;                    ///< --threads of every run (0: all cores)
   double budget_seconds = 3600;       ///< no run starts once this much wall time is spent
+  std::vector<std::string> sweeps;    ///< sweep names to run ("quality preset"); empty: all
   bool quick = false;                 ///< only the first two settings of each problem's first sweep
   bool keep_runs = false;             ///< keep each run's caches (else removed once measured)
   std::function<void(const std::string&)> log;  ///< progress lines
