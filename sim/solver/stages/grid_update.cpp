@@ -13,19 +13,18 @@ void GridUpdateStage::run(StepContext& c) {
   const Vec3 g = c.scene.shot.gravity.cast<Real>();
   const Real dt = static_cast<Real>(c.dt);
   const bool walls = c.grid_shells.empty();
-  parallel_for(
+  parallel_for_each(
       c.grid.num_grid_blocks(), 16,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b)
-          c.grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
-            const Real inv_m = Real(1) / nd.m;
-            for (int a = 0; a < 3; ++a) {
-              Real v = nd.v[a] * inv_m + dt * g[a];
-              if (walls && n[a] < kWallCells && v < 0) v = 0;
-              if (walls && n[a] > c.domain_cells[a] - kWallCells && v > 0) v = 0;
-              nd.v[a] = v;
-            }
-          });
+      [&](std::size_t b) {
+        c.grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
+          const Real inv_m = Real(1) / nd.m;
+          for (int a = 0; a < 3; ++a) {
+            Real v = nd.v[a] * inv_m + dt * g[a];
+            if (walls && n[a] < kWallCells && v < 0) v = 0;
+            if (walls && n[a] > c.domain_cells[a] - kWallCells && v > 0) v = 0;
+            nd.v[a] = v;
+          }
+        });
       },
       c.opt.serial);
 }
