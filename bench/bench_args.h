@@ -1,5 +1,6 @@
 // Small helpers shared by the benchmark programs.
 #pragma once
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -22,6 +23,8 @@ struct SheetArgs {
   double vertices = 100000;
   int steps = 20;
   std::vector<int> threads = {1, 2};
+  /// Quads per side of a square sheet with about `vertices` vertices.
+  int quads_per_side() const { return static_cast<int>(std::round(std::sqrt(vertices))) - 1; }
 };
 
 /// Parses SheetArgs; prints the offending option and returns false on an unknown one.

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bench/bench_args.h"
+#include "bench/timed_advance.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
 
@@ -22,10 +23,8 @@ using namespace shellmpm;
 int main(int argc, char** argv) {
   shellmpm_bench::SheetArgs args;
   if (!shellmpm_bench::parse_sheet_args(argc, argv, args)) return 2;
-  const double vertices = args.vertices;
   const int steps = args.steps;
-  const std::vector<int>& threads = args.threads;
-  const int n = static_cast<int>(std::round(std::sqrt(vertices))) - 1;
+  const int n = args.quads_per_side();
   const double size = 2.0, h = size / n;
   Scene s;
   s.path = "bench";
@@ -61,16 +60,15 @@ int main(int argc, char** argv) {
       "dx = %.4g m, %s\n",
       n, n, (n + 1) * (n + 1), 2 * n * n, h, sizeof(Real) == 4 ? "float" : "double");
   double base = 0;
-  for (int t : threads) {
+  for (int t : args.threads) {
     ThreadLimit limit(t);
     Solver solver(s);
     const double dt = solver.stable_dt();
     // Fall until the cloth touches the ball (2 h at 1.5 m/s), then time.
     solver.advance_to(3 * h / 1.5);
-    const double t0 = solver.time();
-    const auto w0 = std::chrono::steady_clock::now();
-    const FrameStats fs = solver.advance_to(t0 + steps * dt);
-    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    const shellmpm_bench::TimedAdvance run = shellmpm_bench::timed_advance(solver, steps * dt);
+    const FrameStats& fs = run.stats;
+    const double sec = run.seconds;
     const double per_step = sec / fs.substeps;
     const double steps_per_frame = std::ceil(1.0 / (s.shot.fps * dt));
     if (base == 0) base = per_step;

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bench/bench_args.h"
+#include "bench/timed_advance.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
 
@@ -59,10 +60,9 @@ Result run(const Scene& scene, int threads, int steps) {
   ThreadLimit limit(threads);
   Solver solver(scene);
   solver.advance_to(2e-4);  // warm up: allocate the grid, touch memory
-  const double t0 = solver.time();
-  const auto w0 = std::chrono::steady_clock::now();
-  FrameStats fs = solver.advance_to(t0 + steps * 1e-4);
-  const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  const shellmpm_bench::TimedAdvance run = shellmpm_bench::timed_advance(solver, steps * 1e-4);
+  const FrameStats& fs = run.stats;
+  const double sec = run.seconds;
   Result r;
   r.particles = solver.particles().size();
   r.pss = static_cast<double>(r.particles) * fs.substeps / sec;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bench/bench_args.h"
+#include "bench/timed_advance.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
 
@@ -20,10 +21,8 @@ using namespace shellmpm;
 int main(int argc, char** argv) {
   shellmpm_bench::SheetArgs args;
   if (!shellmpm_bench::parse_sheet_args(argc, argv, args)) return 2;
-  const double vertices = args.vertices;
   const int steps = args.steps;
-  const std::vector<int>& threads = args.threads;
-  const int n = static_cast<int>(std::round(std::sqrt(vertices))) - 1;
+  const int n = args.quads_per_side();
   Scene s;
   s.path = "bench";
   s.shot.dx = 0.01;
@@ -56,15 +55,14 @@ int main(int argc, char** argv) {
       "points x %d layers, %s, setup %.2f s\n",
       n, n, probe.shells()[0]->size(), qp, layers, sizeof(Real) == 4 ? "float" : "double", setup);
   double base = 0;
-  for (int t : threads) {
+  for (int t : args.threads) {
     ThreadLimit limit(t);
     Solver solver(s);
     const double dt = solver.stable_dt();
     solver.advance_to(2 * dt);  // warm up
-    const double t0 = solver.time();
-    const auto w0 = std::chrono::steady_clock::now();
-    const FrameStats fs = solver.advance_to(t0 + steps * dt);
-    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    const shellmpm_bench::TimedAdvance run = shellmpm_bench::timed_advance(solver, steps * dt);
+    const FrameStats& fs = run.stats;
+    const double sec = run.seconds;
     double forces = 0;
     for (const auto& [name, v] : fs.stage_seconds)
       if (name == "shell_forces") forces = v;

@@ -57,24 +57,16 @@ std::size_t count_open_edges(const TriMesh& mesh) {
   return open;
 }
 
-}  // namespace
-
-std::shared_ptr<const SdfGrid> mesh_to_sdf(const TriMesh& mesh, double voxel_size,
-                                           int half_band_voxels, const std::string& where) {
-  SHELLMPM_CHECK(voxel_size > 0 && std::isfinite(voxel_size), "voxel_size " << voxel_size);
-  SHELLMPM_CHECK(half_band_voxels >= 1, "half_band_voxels " << half_band_voxels);
-  if (mesh.triangles.empty()) throw detail::user_error_at(where, "mesh has no triangles");
-  const double h = voxel_size;
-  openvdb::initialize();
-
-  // Dense box: bounding box in index space, padded.
+/// The dense sample box: the mesh's bounding box in index space of voxel size h, padded
+/// by pad voxels (lowest index ilo, dims); returns the sample count, or a UserError at
+/// `where` when it is too large.
+double dense_box(const TriMesh& mesh, double h, int pad, const std::string& where, Vec3i& ilo,
+                 Vec3i& dims) {
   Vec3d lo = mesh.vertices[0], hi = lo;
   for (const auto& v : mesh.vertices) {
     lo = lo.cwiseMin(v);
     hi = hi.cwiseMax(v);
   }
-  const int pad = half_band_voxels + 2;
-  Vec3i ilo, dims;
   double samples = 1;
   for (int a = 0; a < 3; ++a) {
     const double l = std::floor(lo[a] / h) - pad, u = std::ceil(hi[a] / h) + pad;
@@ -91,6 +83,49 @@ std::shared_ptr<const SdfGrid> mesh_to_sdf(const TriMesh& mesh, double voxel_siz
        << "or a smaller mesh";
     throw detail::user_error_at(where, os.str());
   }
+  return samples;
+}
+
+/// Throws a UserError at `where` unless the sampled distance encloses a volume: some
+/// sample clearly inside (samples on a face that lies on a grid plane read -1e-7 for open
+/// meshes too), and the padded border entirely outside.
+void check_enclosed(const SdfGrid& sdf, const TriMesh& mesh, const std::string& where) {
+  const double h = sdf.spacing;
+  const std::size_t nx = static_cast<std::size_t>(sdf.dims.x()),
+                    ny = static_cast<std::size_t>(sdf.dims.y()),
+                    nz = static_cast<std::size_t>(sdf.dims.z());
+  const float deep = static_cast<float>(-0.25 * h);
+  bool any_inside = false, border_inside = false;
+  for (std::size_t k = 0; k < nz; ++k)
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t i = 0; i < nx; ++i) {
+        const float v = sdf.values[(k * ny + j) * nx + i];
+        if (!(v < 0)) continue;
+        any_inside = any_inside || v < deep;
+        const bool border = i == 0 || j == 0 || k == 0 || i + 1 == nx || j + 1 == ny || k + 1 == nz;
+        border_inside = border_inside || border;
+      }
+  if (!any_inside || border_inside) {
+    std::ostringstream os;
+    os << "mesh does not enclose a volume at voxel size " << h << " m ("
+       << (any_inside ? "its inside leaks to the outside" : "no point is inside") << "; "
+       << count_open_edges(mesh) << " open edges of " << mesh.triangles.size()
+       << " triangles); sources and colliders need a closed mesh thicker than a voxel";
+    throw detail::user_error_at(where, os.str());
+  }
+}
+
+}  // namespace
+
+std::shared_ptr<const SdfGrid> mesh_to_sdf(const TriMesh& mesh, double voxel_size,
+                                           int half_band_voxels, const std::string& where) {
+  SHELLMPM_CHECK(voxel_size > 0 && std::isfinite(voxel_size), "voxel_size " << voxel_size);
+  SHELLMPM_CHECK(half_band_voxels >= 1, "half_band_voxels " << half_band_voxels);
+  if (mesh.triangles.empty()) throw detail::user_error_at(where, "mesh has no triangles");
+  const double h = voxel_size;
+  openvdb::initialize();
+  Vec3i ilo, dims;
+  const double samples = dense_box(mesh, h, half_band_voxels + 2, where, ilo, dims);
 
   auto xform = openvdb::math::Transform::createLinearTransform(h);
   const float band = static_cast<float>(half_band_voxels);
@@ -116,29 +151,7 @@ std::shared_ptr<const SdfGrid> mesh_to_sdf(const TriMesh& mesh, double voxel_siz
           sdf->values[(k * ny + j) * nx + i] = std::min(acc.getValue(c), outside);
         }
   });
-
-  // An enclosed volume: some sample clearly inside (samples on a face that lies on a
-  // grid plane read -1e-7 for open meshes too), and the padded border entirely outside.
-  const float deep = static_cast<float>(-0.25 * h);
-  bool any_inside = false, border_inside = false;
-  for (std::size_t k = 0; k < static_cast<std::size_t>(dims.z()); ++k)
-    for (std::size_t j = 0; j < ny; ++j)
-      for (std::size_t i = 0; i < nx; ++i) {
-        const float v = sdf->values[(k * ny + j) * nx + i];
-        if (!(v < 0)) continue;
-        any_inside = any_inside || v < deep;
-        const bool border = i == 0 || j == 0 || k == 0 || i + 1 == nx || j + 1 == ny ||
-                            k + 1 == static_cast<std::size_t>(dims.z());
-        border_inside = border_inside || border;
-      }
-  if (!any_inside || border_inside) {
-    std::ostringstream os;
-    os << "mesh does not enclose a volume at voxel size " << h << " m ("
-       << (any_inside ? "its inside leaks to the outside" : "no point is inside") << "; "
-       << count_open_edges(mesh) << " open edges of " << mesh.triangles.size()
-       << " triangles); sources and colliders need a closed mesh thicker than a voxel";
-    throw detail::user_error_at(where, os.str());
-  }
+  check_enclosed(*sdf, mesh, where);
   return sdf;
 }
 

@@ -20,31 +20,27 @@ int type_size(const std::string& t) {
   return 0;
 }
 
+/// The little-endian integer at p: an Unsigned one when is_unsigned, else a Signed one.
+template <class Unsigned, class Signed>
+long long read_integer(const char* p, bool is_unsigned) {
+  if (is_unsigned) {
+    Unsigned v;
+    std::memcpy(&v, p, sizeof v);
+    return static_cast<long long>(v);
+  }
+  Signed v;
+  std::memcpy(&v, p, sizeof v);
+  return static_cast<long long>(v);
+}
+
 long long read_int(const char* p, const std::string& t) {
   switch (type_size(t)) {
     case 1:
-      return t[0] == 'u' ? static_cast<long long>(*reinterpret_cast<const unsigned char*>(p))
-                         : static_cast<long long>(*reinterpret_cast<const signed char*>(p));
-    case 2: {
-      if (t[0] == 'u') {
-        std::uint16_t v;
-        std::memcpy(&v, p, 2);
-        return v;
-      }
-      std::int16_t v;
-      std::memcpy(&v, p, 2);
-      return v;
-    }
-    default: {
-      if (t[0] == 'u') {
-        std::uint32_t v;
-        std::memcpy(&v, p, 4);
-        return v;
-      }
-      std::int32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
-    }
+      return read_integer<unsigned char, signed char>(p, t[0] == 'u');
+    case 2:
+      return read_integer<std::uint16_t, std::int16_t>(p, t[0] == 'u');
+    default:
+      return read_integer<std::uint32_t, std::int32_t>(p, t[0] == 'u');
   }
 }
 

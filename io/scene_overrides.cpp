@@ -149,51 +149,42 @@ YAML::Node load_override_value(const std::string& text, const std::string& where
                       quoted_override(key, text));
 }
 
-}  // namespace
-
-void apply_override(DocNode& root, const std::string& ov) {
-  const std::string where = "--set " + ov;
-  const std::size_t eq = ov.find('=');
-  if (eq == std::string::npos || eq == 0) {
-    throw UserError(where, 0, "", "expected KEY=VALUE, e.g. shot.dx=0.01");
-  }
-  const std::string key = ov.substr(0, eq);
-  const std::string text = ov.substr(eq + 1);
-  const std::vector<PathSeg> segs = split_override_path(key, where);
-  const Origin origin{where, 0};
-
-  // State while walking: the node, what the schema says it is, and its schema prefix.
+/// Where an override's key path has got to: the node, what the schema says it is, and
+/// its schema prefix.
+struct OverrideWalk {
   enum class Expect { Map, List, Leaf };
-  DocNode* cur = &root;
+  explicit OverrideWalk(DocNode* root) : cur(root) {}
+  DocNode* cur;
   Expect expect = Expect::Map;
   std::string prefix;             // Map: prefix of its keys; List: prefix of its items' keys
   std::string path;               // instance path so far
   const KeySpec* leaf = nullptr;  // the schema entry of the last key segment
-  for (std::size_t si = 0; si < segs.size(); ++si) {
-    const PathSeg& seg = segs[si];
-    const bool last = si + 1 == segs.size();
-    const std::string shown = path.empty() ? "the top level" : path;
-    if (seg.is_index) {
-      const std::string item_path = path + "[" + std::to_string(seg.index) + "]";
-      if (expect != Expect::List) {
-        throw UserError(where, 0, item_path, shown + " is not a list");
-      }
-      if (cur->kind != DocNode::Kind::List) {
-        throw UserError(where, 0, item_path,
-                        path + " is " + describe(*cur) + " in the scene, not a list");
-      }
-      if (seg.index >= cur->items.size()) {
-        throw UserError(where, 0, item_path,
-                        "index " + std::to_string(seg.index) + " is out of range: " + path +
-                            " has " + std::to_string(cur->items.size()) + " entr" +
-                            (cur->items.size() == 1 ? "y" : "ies"));
-      }
-      cur = &cur->items[seg.index];
-      path = item_path;
-      expect = Expect::Map;  // every list in the format is a list of mappings
-      if (last) break;
-      continue;
+
+  std::string shown() const { return path.empty() ? "the top level" : path; }
+
+  /// Steps into list entry seg.index (which must exist).
+  void index(const PathSeg& seg, const std::string& where) {
+    const std::string item_path = path + "[" + std::to_string(seg.index) + "]";
+    if (expect != Expect::List) {
+      throw UserError(where, 0, item_path, shown() + " is not a list");
     }
+    if (cur->kind != DocNode::Kind::List) {
+      throw UserError(where, 0, item_path,
+                      path + " is " + describe(*cur) + " in the scene, not a list");
+    }
+    if (seg.index >= cur->items.size()) {
+      throw UserError(where, 0, item_path,
+                      "index " + std::to_string(seg.index) + " is out of range: " + path + " has " +
+                          std::to_string(cur->items.size()) + " entr" +
+                          (cur->items.size() == 1 ? "y" : "ies"));
+    }
+    cur = &cur->items[seg.index];
+    path = item_path;
+    expect = Expect::Map;  // every list in the format is a list of mappings
+  }
+
+  /// Steps into key seg.name (a schema key here), adding it to the document if absent.
+  void key(const PathSeg& seg, const std::string& where) {
     const std::string key_path = join_key(path, seg.name);
     if (expect == Expect::List) {
       throw UserError(where, 0, key_path,
@@ -203,19 +194,20 @@ void apply_override(DocNode& root, const std::string& ov) {
     const KeySpec* s = expect == Expect::Map ? find_spec(join_key(prefix, seg.name)) : nullptr;
     if (!s) {
       throw UserError(where, 0, key_path,
-                      "unknown key '" + seg.name + "' in " + shown + " (known: " +
+                      "unknown key '" + seg.name + "' in " + shown() + " (known: " +
                           (expect == Expect::Map ? known_keys(prefix, nullptr)
                                                  : "none; " + path + " has no sub-keys") +
                           ")");
     }
     if (cur->kind != DocNode::Kind::Map) {
       throw UserError(where, 0, key_path,
-                      shown + " is " + describe(*cur) + " in the scene, not a mapping");
+                      shown() + " is " + describe(*cur) + " in the scene, not a mapping");
     }
     DocEntry* entry = nullptr;
     for (DocEntry& e : cur->entries)
       if (e.key == seg.name) entry = &e;
     if (!entry) {
+      const Origin origin{where, 0};
       DocNode fresh;
       fresh.origin = origin;
       fresh.kind = s->type == KeyType::List ? DocNode::Kind::List : DocNode::Kind::Map;
@@ -230,9 +222,31 @@ void apply_override(DocNode& root, const std::string& ov) {
              : (s->type == KeyType::Map || s->type == KeyType::Shape) ? Expect::Map
                                                                       : Expect::Leaf;
   }
+};
+
+}  // namespace
+
+void apply_override(DocNode& root, const std::string& ov) {
+  const std::string where = "--set " + ov;
+  const std::size_t eq = ov.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw UserError(where, 0, "", "expected KEY=VALUE, e.g. shot.dx=0.01");
+  }
+  const std::string key = ov.substr(0, eq);
+  const std::string text = ov.substr(eq + 1);
+  const std::vector<PathSeg> segs = split_override_path(key, where);
+  OverrideWalk walk(&root);
+  for (std::size_t si = 0; si < segs.size(); ++si) {
+    if (segs[si].is_index) {
+      walk.index(segs[si], where);
+      if (si + 1 == segs.size()) break;
+    } else {
+      walk.key(segs[si], where);
+    }
+  }
   const bool item = !segs.empty() && segs.back().is_index;  // a whole list entry: a mapping
-  *cur =
-      convert(load_override_value(text, where, path, item ? nullptr : leaf), where, false, 0, path);
+  *walk.cur = convert(load_override_value(text, where, walk.path, item ? nullptr : walk.leaf),
+                      where, false, 0, walk.path);
 }
 
 }  // namespace shellmpm::scenefile

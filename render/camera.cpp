@@ -26,15 +26,7 @@ Eigen::Vector3d Camera::project(const Vec3d& x) const {
 }
 
 Eigen::Matrix4f Camera::view_matrix() const {
-  const Vec3d f = forward(), r = right(), u = up();
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.block<1, 3>(0, 0) = r.transpose();
-  m.block<1, 3>(1, 0) = u.transpose();
-  m.block<1, 3>(2, 0) = -f.transpose();
-  m(0, 3) = -r.dot(eye);
-  m(1, 3) = -u.dot(eye);
-  m(2, 3) = f.dot(eye);
-  return m.cast<float>();
+  return view_from_basis<double>(eye, right(), up(), forward()).cast<float>();
 }
 
 Eigen::Matrix4f Camera::projection_matrix(double n, double f) const {

@@ -35,6 +35,24 @@ struct Camera {
   Eigen::Matrix4f projection_matrix(double z_near, double z_far) const;
 };
 
+/// OpenGL view matrix (right-handed, the camera looks down -z) of an eye with the
+/// orthonormal basis right r, up u and forward f; Camera::view_matrix and the raster
+/// renderer's light view share it.
+template <class S>
+Eigen::Matrix<S, 4, 4> view_from_basis(const Eigen::Matrix<S, 3, 1>& eye,
+                                       const Eigen::Matrix<S, 3, 1>& r,
+                                       const Eigen::Matrix<S, 3, 1>& u,
+                                       const Eigen::Matrix<S, 3, 1>& f) {
+  Eigen::Matrix<S, 4, 4> m = Eigen::Matrix<S, 4, 4>::Identity();
+  m.template block<1, 3>(0, 0) = r.transpose();
+  m.template block<1, 3>(1, 0) = u.transpose();
+  m.template block<1, 3>(2, 0) = -f.transpose();
+  m(0, 3) = -r.dot(eye);
+  m(1, 3) = -u.dot(eye);
+  m(2, 3) = f.dot(eye);
+  return m;
+}
+
 /// A camera that frames the box [lo, hi]: it looks at the box center from `azimuth_deg`
 /// around +Y (0 = from +Z) and `elevation_deg` above the horizon, far enough that the
 /// box's bounding sphere fits the narrower field of view with 8% to spare.

@@ -144,19 +144,27 @@ void main() {
 
 constexpr int kShadowSize = 2048;
 
+/// Throws "GLSL <what> error" with the info log of shader or program obj when its
+/// `status` is not set (deleting obj); get_iv, get_log and del are the shader or program
+/// variants of glGet*iv, glGet*InfoLog and glDelete*.
+template <class GetIv, class GetLog, class Delete>
+void check_status(GLuint obj, GLenum status, GetIv get_iv, GetLog get_log, Delete del,
+                  const char* what) {
+  GLint ok = 0;
+  get_iv(obj, status, &ok);
+  if (ok) return;
+  char log[4096] = {};
+  get_log(obj, sizeof log, nullptr, log);
+  del(obj);
+  throw std::runtime_error(std::string("raster renderer: GLSL ") + what + " error: " + log);
+}
+
 GLuint compile(GLenum type, const std::string& src) {
   GLuint s = glCreateShader(type);
   const char* p = src.c_str();
   glShaderSource(s, 1, &p, nullptr);
   glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {};
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    glDeleteShader(s);
-    throw std::runtime_error(std::string("raster renderer: GLSL compile error: ") + log);
-  }
+  check_status(s, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog, glDeleteShader, "compile");
   return s;
 }
 
@@ -168,14 +176,7 @@ GLuint link(const std::string& vs, const std::string& fs) {
   glLinkProgram(p);
   glDeleteShader(v);
   glDeleteShader(f);
-  GLint ok = 0;
-  glGetProgramiv(p, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096] = {};
-    glGetProgramInfoLog(p, sizeof log, nullptr, log);
-    glDeleteProgram(p);
-    throw std::runtime_error(std::string("raster renderer: GLSL link error: ") + log);
-  }
+  check_status(p, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog, glDeleteProgram, "link");
   return p;
 }
 
@@ -188,14 +189,7 @@ Eigen::Matrix4f look_at(const Eigen::Vector3f& eye, const Eigen::Vector3f& targe
   const Eigen::Vector3f f = (target - eye).normalized();
   const Eigen::Vector3f r = f.cross(up_hint).normalized();
   const Eigen::Vector3f u = r.cross(f);
-  Eigen::Matrix4f m = Eigen::Matrix4f::Identity();
-  m.block<1, 3>(0, 0) = r.transpose();
-  m.block<1, 3>(1, 0) = u.transpose();
-  m.block<1, 3>(2, 0) = -f.transpose();
-  m(0, 3) = -r.dot(eye);
-  m(1, 3) = -u.dot(eye);
-  m(2, 3) = f.dot(eye);
-  return m;
+  return view_from_basis<float>(eye, r, u, f);
 }
 
 Eigen::Matrix4f ortho(float half_w, float half_h, float n, float f) {

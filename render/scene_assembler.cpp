@@ -26,25 +26,31 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Box {
-  Vec3d lo = Vec3d::Constant(1e300), hi = Vec3d::Constant(-1e300);
-  bool empty() const { return (lo.array() > hi.array()).any(); }
-  void add(const Vec3d& p) {
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-  }
-};
-
 Vec3f to_f(const Vec3d& v) {
   return v.cast<float>();
 }
 
 constexpr std::size_t kMaxDenseVoxels = std::size_t(32) << 20;
 
-/// The density grid of a VDB cache, or a CacheError naming it.
-openvdb::FloatGrid::Ptr read_density_grid(const std::string& path) {
+/// Throws a CacheError unless the cache file `path` exists.
+void require_cache_file(const std::string& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) throw CacheError(path, "missing (the run did not write this frame)");
+}
+
+/// A PLY cache file, or a CacheError naming it.
+PlyMesh read_ply_cache(const std::string& path) {
+  require_cache_file(path);
+  try {
+    return read_ply(path);
+  } catch (const std::runtime_error& e) {
+    throw CacheError(path, std::string(e.what()).substr(path.size() + 2));
+  }
+}
+
+/// The density grid of a VDB cache, or a CacheError naming it.
+openvdb::FloatGrid::Ptr read_density_grid(const std::string& path) {
+  require_cache_file(path);
   try {
     openvdb::io::File file(path);
     file.open(false);
@@ -162,12 +168,62 @@ Vec3d default_bulk_color(MaterialKind kind) {
   return {0.36, 0.70, 0.30};
 }
 
+/// An axis-aligned box grown point by point: the framing box and the content bounds.
+struct SceneAssembler::Bounds {
+  Vec3d lo = Vec3d::Constant(1e300), hi = Vec3d::Constant(-1e300);
+  bool empty() const { return (lo.array() > hi.array()).any(); }
+  void add(const Vec3d& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  void add(const std::vector<Vec3f>& points) {
+    for (const Vec3f& p : points) add(p.cast<double>());
+  }
+  /// The 8 corners of box [blo, bhi] moved by pose.
+  void add_box(const Vec3d& blo, const Vec3d& bhi, const RigidPose& pose) {
+    for (int c = 0; c < 8; ++c)
+      add(pose.apply(
+          Vec3d(c & 1 ? bhi.x() : blo.x(), c & 2 ? bhi.y() : blo.y(), c & 4 ? bhi.z() : blo.z())));
+  }
+  /// Becomes [dlo, dhi] when empty.
+  void or_else(const Vec3d& dlo, const Vec3d& dhi) {
+    if (!empty()) return;
+    lo = dlo;
+    hi = dhi;
+  }
+};
+
 SceneAssembler::SceneAssembler(const Scene& scene, std::string outdir, int framing_frame)
     : scene_(scene), outdir_(std::move(outdir)) {
   openvdb::initialize();
-  const RenderSettings& rs = scene.render;
-  const OutputSettings& out = scene.output;
-  const bool has_bulk = !scene.sources.empty();
+  choose_bulk();
+  // Colliders, tessellated once in their own frame; the framing box.
+  Bounds box;
+  for (const SourceDesc& src : scene.sources) {
+    if (src.shape.kind == ShapeDesc::Kind::Mesh) {
+      box.add(shape_mesh_file(src.shape).positions);
+    } else {
+      const Aabb b = shape_bounds(src.shape);
+      box.add_box(b.lo, b.hi, RigidPose());
+    }
+  }
+  load_colliders(box);
+  for (const ShellDesc& sh : scene.shells) {
+    if (!sh.write_mesh) continue;
+    try {
+      box.add(read_shell(sh, framing_frame).positions);
+    } catch (const CacheError&) {
+      // framed without this shell
+    }
+  }
+  set_frame(box);
+  choose_camera();
+}
+
+void SceneAssembler::choose_bulk() {
+  const RenderSettings& rs = scene_.render;
+  const OutputSettings& out = scene_.output;
+  const bool has_bulk = !scene_.sources.empty();
   // How the bulk material is drawn.
   // The reader refused a drawing whose cache the run does not write (io/scene_reader.cpp).
   bulk_ = rs.bulk;
@@ -186,31 +242,18 @@ SceneAssembler::SceneAssembler(const Scene& scene, std::string outdir, int frami
   SHELLMPM_CHECK(bulk_ != BulkDraw::Particles || out.particles,
                  "render.bulk draws a particle cache the run does not write");
   if (has_bulk) {
-    const SourceDesc& src = scene.sources.front();
-    const MaterialDesc& mat = scene.materials[static_cast<std::size_t>(src.material)];
+    const SourceDesc& src = scene_.sources.front();
+    const MaterialDesc& mat = scene_.materials[static_cast<std::size_t>(src.material)];
     bulk_color_ = to_f(mat.color ? *mat.color : default_bulk_color(mat.kind));
     particle_radius_ = static_cast<float>(
-        rs.particle_radius.value_or(0.5 * scene.shot.dx / std::cbrt(src.particles_per_cell)));
+        rs.particle_radius.value_or(0.5 * scene_.shot.dx / std::cbrt(src.particles_per_cell)));
   }
+}
 
-  // Colliders, tessellated once in their own frame; the framing box.
-  Box box;
-  auto add_box = [&](const Vec3d& lo, const Vec3d& hi, const RigidPose& pose) {
-    for (int c = 0; c < 8; ++c)
-      box.add(pose.apply(
-          Vec3d(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(), c & 4 ? hi.z() : lo.z())));
-  };
-  for (const SourceDesc& src : scene.sources) {
-    if (src.shape.kind == ShapeDesc::Kind::Mesh) {
-      const RenderMesh m = shape_mesh_file(src.shape);
-      for (const Vec3f& p : m.positions) box.add(p.cast<double>());
-    } else {
-      const Aabb b = shape_bounds(src.shape);
-      add_box(b.lo, b.hi, RigidPose());
-    }
-  }
-  for (std::size_t i = 0; i < scene.colliders.size(); ++i) {
-    const ColliderDesc& c = scene.colliders[i];
+void SceneAssembler::load_colliders(Bounds& box) {
+  const RenderSettings& rs = scene_.render;
+  for (std::size_t i = 0; i < scene_.colliders.size(); ++i) {
+    const ColliderDesc& c = scene_.colliders[i];
     ColliderMesh cm;
     cm.keys = c.keyframes;
     std::vector<RigidPose> poses{keyframe_pose(c.keyframes, 0.0)};
@@ -226,35 +269,24 @@ SceneAssembler::SceneAssembler(const Scene& scene, std::string outdir, int frami
     } else {
       cm.local = c.shape.kind == ShapeDesc::Kind::Mesh ? shape_mesh_file(c.shape)
                                                        : tessellate_shape(c.shape);
-      Box local;
-      for (const Vec3f& p : cm.local.positions) local.add(p.cast<double>());
-      for (const RigidPose& p : poses) add_box(local.lo, local.hi, p);
+      Bounds local;
+      local.add(cm.local.positions);
+      for (const RigidPose& p : poses) box.add_box(local.lo, local.hi, p);
     }
     cm.local.name = c.name;
     cm.local.kind = SurfaceKind::Collider;
     cm.local.front = cm.local.back = to_f(rs.collider_color);
     colliders_.push_back(std::move(cm));
   }
-  for (const ShellDesc& sh : scene.shells) {
-    if (!sh.write_mesh) continue;
-    try {
-      for (const Vec3f& p : read_shell(sh, framing_frame).positions) box.add(p.cast<double>());
-    } catch (const CacheError&) {
-      // framed without this shell
-    }
-  }
-  const Vec3d dlo = scene.shot.domain_min, dhi = scene.shot.domain_max;
-  if (box.empty()) {
-    box.lo = dlo;
-    box.hi = dhi;
-  }
+}
+
+void SceneAssembler::set_frame(Bounds box) {
+  const Vec3d dlo = scene_.shot.domain_min, dhi = scene_.shot.domain_max;
+  box.or_else(dlo, dhi);
   box.lo = box.lo.cwiseMax(dlo);
   box.hi = box.hi.cwiseMin(dhi);
-  if (box.empty()) {
-    box.lo = dlo;
-    box.hi = dhi;
-  }
-  has_ground_ = rs.ground;
+  box.or_else(dlo, dhi);
+  has_ground_ = scene_.render.ground;
   if (has_ground_ && ground_collider_ < 0) {
     ground_point_ =
         Vec3d(0.5 * (box.lo.x() + box.hi.x()), box.lo.y(), 0.5 * (box.lo.z() + box.hi.z()));
@@ -270,8 +302,10 @@ SceneAssembler::SceneAssembler(const Scene& scene, std::string outdir, int frami
   }
   frame_lo_ = box.lo;
   frame_hi_ = box.hi;
+}
 
-  // Camera.
+void SceneAssembler::choose_camera() {
+  const RenderSettings& rs = scene_.render;
   std::string name = rs.camera;
   if (name.empty()) name = rs.cameras.empty() ? "auto" : rs.cameras.front().name;
   if (name == "auto") {
@@ -299,21 +333,16 @@ std::string SceneAssembler::shell_path(const ShellDesc& sh, int frame) const {
 
 RenderMesh SceneAssembler::read_shell(const ShellDesc& sh, int frame) const {
   const std::string path = shell_path(sh, frame);
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw CacheError(path, "missing (the run did not write this frame)");
   RenderMesh m;
   m.name = sh.name;
   m.kind = SurfaceKind::Shell;
   if (scene_.output.shell_format == MeshFormat::Ply) {
-    try {
-      PlyMesh p = read_ply(path);
-      m.positions = std::move(p.positions);
-      m.triangles = std::move(p.triangles);
-      m.normals = std::move(p.normals);
-    } catch (const std::runtime_error& e) {
-      throw CacheError(path, std::string(e.what()).substr(path.size() + 2));
-    }
+    PlyMesh p = read_ply_cache(path);
+    m.positions = std::move(p.positions);
+    m.triangles = std::move(p.triangles);
+    m.normals = std::move(p.normals);
   } else {
+    require_cache_file(path);
     try {
       const TriMesh tm = read_mesh(path, path);
       for (const Vec3d& v : tm.vertices) m.positions.push_back(to_f(v));
@@ -346,26 +375,13 @@ std::vector<std::string> SceneAssembler::files(int frame) const {
   return f;
 }
 
-PreviewScene SceneAssembler::assemble(int frame) const {
+void SceneAssembler::add_mesh(PreviewScene& ps, Bounds& content, RenderMesh m) {
+  if (m.kind != SurfaceKind::Ground) content.add(m.positions);
+  ps.meshes.push_back(std::move(m));
+}
+
+void SceneAssembler::add_bulk(int frame, PreviewScene& ps, Bounds& content) const {
   const RenderSettings& rs = scene_.render;
-  const double t = (frame - 1) / scene_.shot.fps;
-  PreviewScene ps;
-  ps.samples = rs.samples;
-  ps.ao_samples = rs.ao_samples;
-  const Vec3d fc = 0.5 * (frame_lo_ + frame_hi_);
-  const double fr = std::max(0.5 * (frame_hi_ - frame_lo_).norm(), 1e-3);
-  Box content;
-  auto add_mesh = [&](RenderMesh m) {
-    if (m.kind != SurfaceKind::Ground)
-      for (const Vec3f& p : m.positions) content.add(p.cast<double>());
-    ps.meshes.push_back(std::move(m));
-  };
-
-  // Shells first: a shell cache error is the most likely and cheapest to detect.
-  for (const ShellDesc& sh : scene_.shells)
-    if (sh.write_mesh) add_mesh(read_shell(sh, frame));
-
-  // Bulk material.
   if (bulk_ == BulkDraw::Volume || bulk_ == BulkDraw::Surface) {
     const std::string path = frame_path(outdir_, scene_.output.density_pattern, frame);
     const openvdb::FloatGrid::Ptr grid = scalar_grid_from_output_axes<openvdb::FloatGrid>(
@@ -373,7 +389,7 @@ PreviewScene SceneAssembler::assemble(int frame) const {
     if (bulk_ == BulkDraw::Surface) {
       RenderMesh m = iso_surface(*grid, rs.iso_value);
       m.front = m.back = bulk_color_;
-      if (!m.triangles.empty()) add_mesh(std::move(m));
+      if (!m.triangles.empty()) add_mesh(ps, content, std::move(m));
     } else {
       ps.volume = dense_volume(*grid);
       ps.volume.extinction = static_cast<float>(rs.volume_extinction);
@@ -387,21 +403,17 @@ PreviewScene SceneAssembler::assemble(int frame) const {
     }
   } else if (bulk_ == BulkDraw::Particles) {
     const std::string path = frame_path(outdir_, scene_.output.particles_pattern, frame);
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw CacheError(path, "missing (the run did not write this frame)");
-    try {
-      ps.particles.positions = read_ply(path).positions;
-      points_from_output_axes(ps.particles.positions, scene_.output.up_axis);
-    } catch (const std::runtime_error& e) {
-      throw CacheError(path, std::string(e.what()).substr(path.size() + 2));
-    }
+    ps.particles.positions = read_ply_cache(path).positions;
+    points_from_output_axes(ps.particles.positions, scene_.output.up_axis);
     ps.particles.radius = particle_radius_;
     ps.particles.color = bulk_color_;
-    for (const Vec3f& p : ps.particles.positions) content.add(p.cast<double>());
+    content.add(ps.particles.positions);
     cull_hidden_particles(ps.particles);  // buried ones can neither be seen nor cast shadows
   }
+}
 
-  // Colliders at the frame's time.
+void SceneAssembler::add_colliders(double t, const Vec3d& fc, double fr, PreviewScene& ps,
+                                   Bounds& content) const {
   const Vec3d eye = camera_.eye;
   for (std::size_t i = 0; i < scene_.colliders.size(); ++i) {
     const ColliderDesc& c = scene_.colliders[i];
@@ -415,53 +427,68 @@ PreviewScene SceneAssembler::assemble(int frame) const {
       RenderMesh m = tessellate_square(center, n, 3.0 * fr, 8);
       m.name = c.name;
       m.kind = SurfaceKind::Collider;
-      m.front = m.back = to_f(rs.collider_color);
+      m.front = m.back = to_f(scene_.render.collider_color);
       ps.meshes.push_back(std::move(m));  // unbounded: not part of the shadow bounds
       continue;
     }
-    add_mesh(posed(colliders_[i].local, pose));
+    add_mesh(ps, content, posed(colliders_[i].local, pose));
   }
+}
 
-  // Ground.
+void SceneAssembler::add_ground(double t, const Vec3d& fc, double fr, PreviewScene& ps) const {
+  if (!has_ground_) return;
   Vec3d gp = ground_point_, gn = ground_normal_;
-  if (has_ground_ && ground_collider_ >= 0) {
+  if (ground_collider_ >= 0) {
     const ColliderDesc& c = scene_.colliders[static_cast<std::size_t>(ground_collider_)];
     const RigidPose pose = keyframe_pose(c.keyframes, t);
     gn = (pose.R * c.shape.normal).normalized();
     gp = pose.apply(c.shape.point);
   }
-  if (has_ground_) {
-    const Vec3d center = fc - gn * gn.dot(fc - gp);
-    const double half = 4.0 * fr;
-    RenderMesh g = tessellate_square(center, gn, half, 16);
-    g.name = "ground";
-    g.kind = SurfaceKind::Ground;
-    g.front = g.back = to_f(rs.ground_color);
-    ps.ground.center = to_f(center);
-    ps.ground.radius = static_cast<float>(half);
-    ps.ground.tile = static_cast<float>(nice_tile(fr));
-    ps.meshes.push_back(std::move(g));
-  }
+  const Vec3d center = fc - gn * gn.dot(fc - gp);
+  const double half = 4.0 * fr;
+  RenderMesh g = tessellate_square(center, gn, half, 16);
+  g.name = "ground";
+  g.kind = SurfaceKind::Ground;
+  g.front = g.back = to_f(scene_.render.ground_color);
+  ps.ground.center = to_f(center);
+  ps.ground.radius = static_cast<float>(half);
+  ps.ground.tile = static_cast<float>(nice_tile(fr));
+  ps.meshes.push_back(std::move(g));
+}
 
-  // Lights: a studio rig relative to the camera (or the scene's key direction).
+void SceneAssembler::add_lights(PreviewScene& ps) const {
+  // A studio rig relative to the camera (or the scene's key direction).
   const Vec3d up(0, 1, 0);
   Vec3d back = camera_.eye - camera_.target;
   back.y() = 0.0;
   if (back.norm() < 1e-9) back = -camera_.up();  // looking straight down
   back.normalize();
   const Vec3d right = up.cross(back).normalized();
-  const Vec3d key =
-      rs.key_light ? *rs.key_light : (1.1 * up - 0.6 * right + 0.5 * back).normalized();
+  const Vec3d key = scene_.render.key_light ? *scene_.render.key_light
+                                            : (1.1 * up - 0.6 * right + 0.5 * back).normalized();
   ps.lights.key_dir = to_f(key.normalized());
   ps.lights.fill_dir = to_f((0.35 * up + 0.8 * right + 0.6 * back).normalized());
   ps.lights.key = 0.8f;
   ps.lights.fill = 0.25f;
   ps.lights.ambient = 0.3f;
+}
 
-  if (content.empty()) {
-    content.lo = frame_lo_;
-    content.hi = frame_hi_;
-  }
+PreviewScene SceneAssembler::assemble(int frame) const {
+  const double t = (frame - 1) / scene_.shot.fps;
+  PreviewScene ps;
+  ps.samples = scene_.render.samples;
+  ps.ao_samples = scene_.render.ao_samples;
+  const Vec3d fc = 0.5 * (frame_lo_ + frame_hi_);
+  const double fr = std::max(0.5 * (frame_hi_ - frame_lo_).norm(), 1e-3);
+  Bounds content;
+  // Shells first: a shell cache error is the most likely and cheapest to detect.
+  for (const ShellDesc& sh : scene_.shells)
+    if (sh.write_mesh) add_mesh(ps, content, read_shell(sh, frame));
+  add_bulk(frame, ps, content);
+  add_colliders(t, fc, fr, ps, content);  // at the frame's time
+  add_ground(t, fc, fr, ps);
+  add_lights(ps);
+  content.or_else(frame_lo_, frame_hi_);
   ps.bounds_lo = to_f(content.lo);
   ps.bounds_hi = to_f(content.hi);
   ps.ao_distance = static_cast<float>(0.15 * fr);

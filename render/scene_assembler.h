@@ -57,6 +57,28 @@ class SceneAssembler {
   Vec3f bulk_color_{0.5f, 0.5f, 0.5f};
   float particle_radius_ = 0.01f;
 
+  struct Bounds;
+
+  // Construction steps, in order.
+  /// bulk_ from render.bulk, the renderer and the caches written; bulk colour and radius.
+  void choose_bulk();
+  /// colliders_ tessellated in their own frame, the ground plane collider; grows box by
+  /// the colliders' keyframed poses.
+  void load_colliders(Bounds& box);
+  /// frame_lo_, frame_hi_ from box (clamped to the domain, down to the ground) and the
+  /// synthetic ground.
+  void set_frame(Bounds box);
+  /// camera_: render.camera, the first named camera, or framed on the box ("auto").
+  void choose_camera();
+
+  // Steps of assemble(); content grows by what they add (t: the frame's time, fc, fr: the
+  // framing box's center and radius).
+  static void add_mesh(PreviewScene& ps, Bounds& content, RenderMesh m);
+  void add_bulk(int frame, PreviewScene& ps, Bounds& content) const;
+  void add_colliders(double t, const Vec3d& fc, double fr, PreviewScene& ps, Bounds& content) const;
+  void add_ground(double t, const Vec3d& fc, double fr, PreviewScene& ps) const;
+  void add_lights(PreviewScene& ps) const;
+
   std::string shell_path(const ShellDesc& sh, int frame) const;
   RenderMesh read_shell(const ShellDesc& sh, int frame) const;
 };

@@ -53,26 +53,22 @@ ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders,
                                          const std::vector<std::uint8_t>* held, bool serial) {
   ProjectionStats total;
   if (colliders.empty() || x.empty()) return total;
-  const std::size_t n = x.size(), chunks = (n + kGrain - 1) / kGrain;
-  std::vector<ProjectionStats> part(chunks);
-  parallel_for(
-      n, kGrain,
-      [&](std::size_t b, std::size_t e) {
-        ProjectionStats& st = part[b / kGrain];
-        for (std::size_t i = b; i < e; ++i) {
-          if (held && (*held)[i]) continue;
-          // The second pass only for points the first one moved.
-          bool moved = false;
-          for (int pass = 0; pass < 2 && (pass == 0 || moved); ++pass)
-            for (const Collider& c : colliders) {
-              const int r = project_point(c, dx, dt, pass == 0, x[i], v[i]);
-              st.inside += r == 1;
-              st.swept += r == 2;
-              moved = moved || r != 0;
-            }
-        }
-      },
-      serial);
+  const std::vector<ProjectionStats> part =
+      chunk_parts(x.size(), kGrain, serial, ProjectionStats{},
+                  [&](std::size_t b, std::size_t e, ProjectionStats& st) {
+                    for (std::size_t i = b; i < e; ++i) {
+                      if (held && (*held)[i]) continue;
+                      // The second pass only for points the first one moved.
+                      bool moved = false;
+                      for (int pass = 0; pass < 2 && (pass == 0 || moved); ++pass)
+                        for (const Collider& c : colliders) {
+                          const int r = project_point(c, dx, dt, pass == 0, x[i], v[i]);
+                          st.inside += r == 1;
+                          st.swept += r == 2;
+                          moved = moved || r != 0;
+                        }
+                    }
+                  });
   for (const ProjectionStats& p : part) {
     total.inside += p.inside;
     total.swept += p.swept;

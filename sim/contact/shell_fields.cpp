@@ -76,20 +76,18 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
   F.nodes.resize(ng);
   F.r.resize(ng);
   const Real dx = static_cast<Real>(F.grid.dx());
-  parallel_for(
+  parallel_for_each(
       nb, 1,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          auto& buf = F.buf[b];
-          Node::clear(buf.data(), buf.size());
-          const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
-          for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
-            const std::uint32_t j = F.grid.order[q];
-            const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
-            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, folds_);
-            for_each_stencil_node(
-                W, bc, [&](const StencilNode& n) { P.add(buf[n.pad()], n.w, n.i, n.j, n.k); });
-          }
+      [&](std::size_t b) {
+        auto& buf = F.buf[b];
+        Node::clear(buf.data(), buf.size());
+        const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
+        for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
+          const std::uint32_t j = F.grid.order[q];
+          const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
+          const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, folds_);
+          for_each_stencil_node(
+              W, bc, [&](const StencilNode& n) { P.add(buf[n.pad()], n.w, n.i, n.j, n.k); });
         }
       },
       serial);
@@ -102,18 +100,16 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
         d.o[a] /= d.m;
       }
   };
-  parallel_for(
+  parallel_for_each(
       ng, 4,
-      [&](std::size_t gb, std::size_t ge) {
-        for (std::size_t g = gb; g < ge; ++g) {
-          auto& nodes = F.nodes[g];
-          Node::clear(nodes.data(), nodes.size());
-          F.r[g].fill(Vec3::Zero());
-          F.grid.for_each_buffer_node(
-              g, [&](int dn, std::size_t src, int sn) { nodes[dn] += F.buf[src][sn]; });
-          if (!folds_)
-            for (Node& d : nodes) normalise(d);
-        }
+      [&](std::size_t g) {
+        auto& nodes = F.nodes[g];
+        Node::clear(nodes.data(), nodes.size());
+        F.r[g].fill(Vec3::Zero());
+        F.grid.for_each_buffer_node(
+            g, [&](int dn, std::size_t src, int sn) { nodes[dn] += F.buf[src][sn]; });
+        if (!folds_)
+          for (Node& d : nodes) normalise(d);
       },
       serial);
   if (!folds_) {
@@ -122,14 +118,12 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
     return;
   }
   split_folds(F, gs, dt, serial);
-  parallel_for(
+  parallel_for_each(
       ng, 16,
-      [&](std::size_t gb, std::size_t ge) {
-        for (std::size_t g = gb; g < ge; ++g) {
-          for (Node& d : F.nodes[g]) normalise(d);
-          if (F.fold[g] >= 0)
-            for (Node& d : F.folds[F.fold[g]].second) normalise(d);
-        }
+      [&](std::size_t g) {
+        for (Node& d : F.nodes[g]) normalise(d);
+        if (F.fold[g] >= 0)
+          for (Node& d : F.folds[F.fold[g]].second) normalise(d);
       },
       serial);
 }
@@ -145,55 +139,172 @@ void ShellFields::bulk_moments(const SparseGrid& combined, const ParticleSet& bu
       const int g = combined.pblock_nbr[b][o];
       if (g >= 0 && fielded_[g]) touch[b] = 1;
     }
-  parallel_for(
+  parallel_for_each(
       nb, 1,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          if (!touch[b]) continue;
-          auto& buf = bulk_buf_[b];
-          std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
-          const Vec3i bc = unpack_block(combined.pblock_key[b]) * kBlockSize;
-          const auto* o = combined.order.data();
-          const std::uint32_t s1 = combined.pblock_start[b + 1];
-          // Bulk particles follow the shell points in each block's sorted slice.
-          const std::uint32_t s0 = static_cast<std::uint32_t>(
-              std::lower_bound(o + combined.pblock_start[b], o + s1, first_bulk) - o);
-          for (std::uint32_t q = s0; q < s1; ++q) {
-            const std::uint32_t p = o[q] - first_bulk;
-            const QuadraticWeights W(combined.grid_coord(bulk.x[p]));
-            const Real m = bulk.volume[p];  // volume-weighted: the densities cancel in a centroid
-            for_each_stencil_node(W, bc, [&](const StencilNode& n) {
-              const Real w = n.w * m;
-              Moment& nd = buf[n.pad()];
-              nd.m += w;
-              nd.o[0] += w * (W.fx[0] - Real(n.i));
-              nd.o[1] += w * (W.fx[1] - Real(n.j));
-              nd.o[2] += w * (W.fx[2] - Real(n.k));
-            });
-          }
-        }
-      },
-      serial);
-  parallel_for(
-      ng, 4,
-      [&](std::size_t gb, std::size_t ge) {
-        for (std::size_t g = gb; g < ge; ++g) {
-          if (!fielded_[g]) continue;
-          auto& nodes = bulk_mom_[g];
-          std::memset(static_cast<void*>(nodes.data()), 0, sizeof(nodes));
-          combined.for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
-            if (!touch[src]) return;
-            const Moment& from = bulk_buf_[src][sn];
-            Moment& d = nodes[dn];
-            d.m += from.m;
-            for (int a = 0; a < 3; ++a) d.o[a] += from.o[a];
+      [&](std::size_t b) {
+        if (!touch[b]) return;
+        auto& buf = bulk_buf_[b];
+        std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
+        const Vec3i bc = unpack_block(combined.pblock_key[b]) * kBlockSize;
+        const auto* o = combined.order.data();
+        const std::uint32_t s1 = combined.pblock_start[b + 1];
+        // Bulk particles follow the shell points in each block's sorted slice.
+        const std::uint32_t s0 = static_cast<std::uint32_t>(
+            std::lower_bound(o + combined.pblock_start[b], o + s1, first_bulk) - o);
+        for (std::uint32_t q = s0; q < s1; ++q) {
+          const std::uint32_t p = o[q] - first_bulk;
+          const QuadraticWeights W(combined.grid_coord(bulk.x[p]));
+          const Real m = bulk.volume[p];  // volume-weighted: the densities cancel in a centroid
+          for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+            const Real w = n.w * m;
+            Moment& nd = buf[n.pad()];
+            nd.m += w;
+            nd.o[0] += w * (W.fx[0] - Real(n.i));
+            nd.o[1] += w * (W.fx[1] - Real(n.j));
+            nd.o[2] += w * (W.fx[2] - Real(n.k));
           });
-          for (Moment& d : nodes)
-            if (d.m > 0)
-              for (Real& x : d.o) x /= d.m;
         }
       },
       serial);
+  parallel_for_each(
+      ng, 4,
+      [&](std::size_t g) {
+        if (!fielded_[g]) return;
+        auto& nodes = bulk_mom_[g];
+        std::memset(static_cast<void*>(nodes.data()), 0, sizeof(nodes));
+        combined.for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
+          if (!touch[src]) return;
+          const Moment& from = bulk_buf_[src][sn];
+          Moment& d = nodes[dn];
+          d.m += from.m;
+          for (int a = 0; a < 3; ++a) d.o[a] += from.o[a];
+        });
+        for (Moment& d : nodes)
+          if (d.m > 0)
+            for (Real& x : d.o) x /= d.m;
+      },
+      serial);
+}
+
+void ShellFields::find_field_blocks(const SparseGrid& combined, bool serial) {
+  const std::size_t K = fields_.size(), ng = combined.num_grid_blocks();
+  fblock_.assign(ng * K, -1);
+  fielded_.assign(ng, 0);
+  parallel_for_each(
+      ng, 16,
+      [&](std::size_t g) {
+        int* fb = fblock_.data() + g * K;
+        for (std::size_t s = 0; s < K; ++s) {
+          fb[s] = fields_[s].grid.find_grid_block(combined.gblock_key[g]);
+          if (fb[s] >= 0) fielded_[g] = 1;
+        }
+      },
+      serial);
+}
+
+Real ShellFields::node_bodies(std::size_t g, int n, std::vector<Body>& bodies) {
+  const int* fb = fblock_.data() + g * fields_.size();
+  bodies.clear();
+  Real ms = 0;
+  for (std::size_t s = 0; s < fields_.size(); ++s) {
+    if (fb[s] < 0) continue;
+    Field& F = fields_[s];
+    const auto push = [&](const Node& f, Vec3& r) {
+      if (f.m <= 0) return;
+      ms += f.m;
+      bodies.push_back({static_cast<int>(s), &f, &r, Vec3(f.p[0], f.p[1], f.p[2]), Vec3::Zero(),
+                        Vec3::Zero(), Vec3::Zero(), Real(0)});
+    };
+    push(F.nodes[fb[s]][n], F.r[fb[s]][n]);
+    const int fi = F.fold[fb[s]];
+    if (fi >= 0) push(F.folds[fi].second[n], F.folds[fi].r[n]);
+  }
+  return ms;
+}
+
+void ShellFields::body_geometry(Body& B) {
+  const Node& f = *B.f;
+  const Vec3 ns(f.n[0], f.n[1], f.n[2]), Ns(f.N[0], f.N[1], f.N[2]);
+  const Real nl = ns.norm(), Nl = Ns.norm();
+  B.nrm = nl > 0 ? Vec3(ns / nl) : Vec3::Zero();
+  B.own = Nl > 0 ? Vec3(Ns / Nl) : Vec3::Zero();
+  B.off = Vec3(f.o[0], f.o[1], f.o[2]);
+  B.winv = std::max(f.m - f.held, Real(0)) / (f.m * f.m);
+}
+
+void ShellFields::shell_pairs(std::vector<Body>& bodies) const {
+  const std::size_t cnt = bodies.size();
+  for (std::size_t i = 0; i < cnt; ++i)
+    for (std::size_t j = i + 1; j < cnt; ++j) {
+      Body &A = bodies[i], &B = bodies[j];
+      const Real facing = A.nrm.dot(B.nrm);
+      Vec3 nab;  // unit normal from a towards b
+      if (facing < Real(-0.5)) {
+        nab = (A.nrm - B.nrm).normalized();
+      } else if (facing > Real(0.5)) {
+        // Both on the same side of the node: closer than a cell, no node between
+        // them. The one whose centroid lies nearer the node along their common
+        // normal u is in front; without this the rule let go exactly when two
+        // sheets were pressed closest (hanging curtains hit at 20 m/s crossed).
+        const Vec3 u = (A.nrm + B.nrm).normalized();
+        const Real h = u.dot(B.off - A.off);
+        if (std::abs(h) < Real(0.05)) continue;
+        nab = h > 0 ? u : Vec3(-u);
+      } else {
+        continue;
+      }
+      field_contact(nab, std::sqrt(friction_[A.shell] * friction_[B.shell]), A.winv, A.vel, B.winv,
+                    B.vel);
+    }
+}
+
+void ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk) const {
+  // Which side of a shell the bulk material is on: where its mass centroid lies
+  // along the shell's own normal (Nairn's multi-material contact takes the
+  // normal from the mass distribution the same way). The node's side is not
+  // enough: the kernel spreads a body's mass 1.5 dx past its particles, so a
+  // heavy block on a light film also has mass at nodes under the film, where
+  // "the node's side" reads its approach as separation and lets it through.
+  // The node's side stays the fallback where the bulk centroid lies on the
+  // shell (within 0.05 dx: bulk on both sides).
+  Vec3 ok = Vec3::Zero();
+  bool have_ok = false;
+  if (bm && bm->m > 0) {
+    ok = Vec3(bm->o[0], bm->o[1], bm->o[2]);
+    have_ok = true;
+  }
+  for (Body& B : bodies) {
+    Vec3 nb = B.nrm;
+    if (have_ok && B.own.squaredNorm() > 0) {
+      const Real d = B.own.dot(ok - B.off);
+      if (std::abs(d) > Real(0.05)) nb = d > 0 ? B.own : Vec3(-B.own);
+    }
+    if (nb.squaredNorm() > 0)
+      field_contact(nb, friction_[B.shell], B.winv, B.vel, Real(1) / mk, vk);
+  }
+}
+
+void ShellFields::resolve_node(const GridNode& cn, std::size_t g, int n, bool moments,
+                               std::vector<Body>& bodies) {
+  const Real ms = node_bodies(g, n, bodies);
+  const Real mk = cn.m - ms;  // the bulk material's share
+  const bool bulk = mk >= kBulkMin * cn.m;
+  const std::size_t cnt = bodies.size();
+  if (cnt == 0 || cnt + (bulk ? 1 : 0) < 2) return;
+  if (!bulk && mk > kShellOnly * cn.m) return;  // a sliver of bulk: one velocity
+  const Vec3 p(cn.v[0], cn.v[1], cn.v[2]);
+  const Vec3 v0 = p / cn.m;
+  Vec3 ps = Vec3::Zero();
+  for (const Body& B : bodies) ps += B.f->m * B.vel;
+  Vec3 vk = bulk ? Vec3((p - ps) / mk) : Vec3::Zero();
+  for (Body& B : bodies) body_geometry(B);
+  // Shell against shell (facing across the node, or stacked on one side of it),
+  // then each shell against the bulk field: Bardenhagen's rule.
+  shell_pairs(bodies);
+  if (bulk) bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk);
+  for (const Body& B : bodies) *B.r = B.vel - v0;
+  if (bulk) r_bulk_[g][n] = vk - v0;
+  shared_[g] |= std::uint64_t(1) << n;
 }
 
 void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& shells, Real dt,
@@ -205,132 +316,21 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
     friction_[s] = shells[s].contact->params().friction;
   }
   const std::size_t ng = combined.num_grid_blocks();
-  fblock_.assign(ng * K, -1);
-  fielded_.assign(ng, 0);
+  find_field_blocks(combined, serial);
   r_bulk_.resize(ng);
   shared_.assign(ng, 0);
-  parallel_for(
-      ng, 16,
-      [&](std::size_t gb, std::size_t ge) {
-        for (std::size_t g = gb; g < ge; ++g) {
-          int* fb = fblock_.data() + g * K;
-          for (std::size_t s = 0; s < K; ++s) {
-            fb[s] = fields_[s].grid.find_grid_block(combined.gblock_key[g]);
-            if (fb[s] >= 0) fielded_[g] = 1;
-          }
-        }
-      },
-      serial);
   const bool moments = bulk_particles && bulk_particles->size() > 0;
   if (moments) bulk_moments(combined, *bulk_particles, first_bulk, serial);
   parallel_for(
       ng, 4,
       [&](std::size_t gb, std::size_t ge) {
-        // The bodies at a node: each shell here, or each of its two classes where it folds.
-        struct Body {
-          int shell;
-          const Node* f;
-          Vec3* r;
-          Vec3 vel, nrm, own, off;  ///< velocity, normal to the node, own normal, centroid
-          Real winv;                ///< inverse effective mass (pinned share: infinite)
-        };
         std::vector<Body> bodies;
         for (std::size_t g = gb; g < ge; ++g) {
           if (!fielded_[g]) continue;
-          const int* fb = fblock_.data() + g * K;
           r_bulk_[g].fill(Vec3::Zero());
           for (int n = 0; n < kBlockNodes; ++n) {
             const GridNode& cn = combined.gblock_nodes[g][n];
-            if (cn.m <= 0) continue;
-            bodies.clear();
-            Real ms = 0;
-            for (std::size_t s = 0; s < K; ++s) {
-              if (fb[s] < 0) continue;
-              Field& F = fields_[s];
-              const auto push = [&](const Node& f, Vec3& r) {
-                if (f.m <= 0) return;
-                ms += f.m;
-                bodies.push_back({static_cast<int>(s), &f, &r, Vec3(f.p[0], f.p[1], f.p[2]),
-                                  Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Real(0)});
-              };
-              push(F.nodes[fb[s]][n], F.r[fb[s]][n]);
-              const int fi = F.fold[fb[s]];
-              if (fi >= 0) push(F.folds[fi].second[n], F.folds[fi].r[n]);
-            }
-            const Real mk = cn.m - ms;  // the bulk material's share
-            const bool bulk = mk >= kBulkMin * cn.m;
-            const std::size_t cnt = bodies.size();
-            if (cnt == 0 || cnt + (bulk ? 1 : 0) < 2) continue;
-            if (!bulk && mk > kShellOnly * cn.m) continue;  // a sliver of bulk: one velocity
-            const Vec3 p(cn.v[0], cn.v[1], cn.v[2]);
-            const Vec3 v0 = p / cn.m;
-            Vec3 ps = Vec3::Zero();
-            for (const Body& B : bodies) ps += B.f->m * B.vel;
-            Vec3 vk = bulk ? Vec3((p - ps) / mk) : Vec3::Zero();
-            for (Body& B : bodies) {
-              const Node& f = *B.f;
-              const Vec3 ns(f.n[0], f.n[1], f.n[2]), Ns(f.N[0], f.N[1], f.N[2]);
-              const Real nl = ns.norm(), Nl = Ns.norm();
-              B.nrm = nl > 0 ? Vec3(ns / nl) : Vec3::Zero();
-              B.own = Nl > 0 ? Vec3(Ns / Nl) : Vec3::Zero();
-              B.off = Vec3(f.o[0], f.o[1], f.o[2]);
-              B.winv = std::max(f.m - f.held, Real(0)) / (f.m * f.m);
-            }
-            // Shell against shell (facing across the node, or stacked on one side of it),
-            // then each shell against the bulk field: Bardenhagen's rule.
-            for (std::size_t i = 0; i < cnt; ++i)
-              for (std::size_t j = i + 1; j < cnt; ++j) {
-                Body &A = bodies[i], &B = bodies[j];
-                const Real facing = A.nrm.dot(B.nrm);
-                Vec3 nab;  // unit normal from a towards b
-                if (facing < Real(-0.5)) {
-                  nab = (A.nrm - B.nrm).normalized();
-                } else if (facing > Real(0.5)) {
-                  // Both on the same side of the node: closer than a cell, no node between
-                  // them. The one whose centroid lies nearer the node along their common
-                  // normal u is in front; without this the rule let go exactly when two
-                  // sheets were pressed closest (hanging curtains hit at 20 m/s crossed).
-                  const Vec3 u = (A.nrm + B.nrm).normalized();
-                  const Real h = u.dot(B.off - A.off);
-                  if (std::abs(h) < Real(0.05)) continue;
-                  nab = h > 0 ? u : Vec3(-u);
-                } else {
-                  continue;
-                }
-                field_contact(nab, std::sqrt(friction_[A.shell] * friction_[B.shell]), A.winv,
-                              A.vel, B.winv, B.vel);
-              }
-            if (bulk) {
-              // Which side of a shell the bulk material is on: where its mass centroid lies
-              // along the shell's own normal (Nairn's multi-material contact takes the
-              // normal from the mass distribution the same way). The node's side is not
-              // enough: the kernel spreads a body's mass 1.5 dx past its particles, so a
-              // heavy block on a light film also has mass at nodes under the film, where
-              // "the node's side" reads its approach as separation and lets it through.
-              // The node's side stays the fallback where the bulk centroid lies on the
-              // shell (within 0.05 dx: bulk on both sides).
-              Vec3 ok = Vec3::Zero();
-              bool have_ok = false;
-              if (moments) {
-                const Moment& bm = bulk_mom_[g][n];
-                if (bm.m > 0) {
-                  ok = Vec3(bm.o[0], bm.o[1], bm.o[2]);
-                  have_ok = true;
-                }
-              }
-              for (Body& B : bodies) {
-                Vec3 nb = B.nrm;
-                if (have_ok && B.own.squaredNorm() > 0) {
-                  const Real d = B.own.dot(ok - B.off);
-                  if (std::abs(d) > Real(0.05)) nb = d > 0 ? B.own : Vec3(-B.own);
-                }
-                if (nb.squaredNorm() > 0)
-                  field_contact(nb, friction_[B.shell], B.winv, B.vel, Real(1) / mk, vk);
-              }
-            }
-            for (const Body& B : bodies) *B.r = B.vel - v0;
-            if (bulk) r_bulk_[g][n] = vk - v0;
-            shared_[g] |= std::uint64_t(1) << n;
+            if (cn.m > 0) resolve_node(cn, g, n, moments, bodies);
           }
         }
       },
@@ -339,31 +339,29 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
 
 void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial) {
   const std::size_t K = fields_.size();
-  parallel_for(
+  parallel_for_each(
       combined.num_grid_blocks(), 4,
-      [&](std::size_t gb, std::size_t ge) {
-        for (std::size_t g = gb; g < ge; ++g) {
-          if (!shared_[g]) continue;
-          const int* fb = fblock_.data() + g * K;
-          const Vec3i c = unpack_block(combined.gblock_key[g]) * kBlockSize;
-          for (int n = 0; n < kBlockNodes; ++n) {
-            if (!(shared_[g] >> n & 1)) continue;
-            const bool one = skip && skip(c + Vec3i(n >> 4, (n >> 2) & 3, n & 3));
-            const Vec3 rk = r_bulk_[g][n];
-            for (std::size_t s = 0; s < K; ++s) {
-              if (fb[s] < 0) continue;
-              Field& F = fields_[s];
-              Vec3& r = F.r[fb[s]][n];
-              r = one ? Vec3::Zero() : Vec3(r - rk);
-              const int fi = F.fold[fb[s]];
-              if (fi < 0) continue;
-              Vec3& r2 = F.folds[fi].r[n];
-              r2 = one ? Vec3::Zero() : Vec3(r2 - rk);
-            }
-            if (one) continue;
-            GridNode& nd = combined.gblock_nodes[g][n];
-            for (int a = 0; a < 3; ++a) nd.v[a] += rk[a];
+      [&](std::size_t g) {
+        if (!shared_[g]) return;
+        const int* fb = fblock_.data() + g * K;
+        const Vec3i c = unpack_block(combined.gblock_key[g]) * kBlockSize;
+        for (int n = 0; n < kBlockNodes; ++n) {
+          if (!(shared_[g] >> n & 1)) continue;
+          const bool one = skip && skip(c + Vec3i(n >> 4, (n >> 2) & 3, n & 3));
+          const Vec3 rk = r_bulk_[g][n];
+          for (std::size_t s = 0; s < K; ++s) {
+            if (fb[s] < 0) continue;
+            Field& F = fields_[s];
+            Vec3& r = F.r[fb[s]][n];
+            r = one ? Vec3::Zero() : Vec3(r - rk);
+            const int fi = F.fold[fb[s]];
+            if (fi < 0) continue;
+            Vec3& r2 = F.folds[fi].r[n];
+            r2 = one ? Vec3::Zero() : Vec3(r2 - rk);
           }
+          if (one) continue;
+          GridNode& nd = combined.gblock_nodes[g][n];
+          for (int a = 0; a < 3; ++a) nd.v[a] += rk[a];
         }
       },
       serial);
@@ -378,45 +376,43 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
     ShellObject& sh = *gs.shell;
     const Real c_scale = Real(4) / static_cast<Real>(F.grid.dx());
     const bool folded = !F.folds.empty();
-    parallel_for(
+    parallel_for_each(
         F.grid.num_particle_blocks(), 1,
-        [&](std::size_t bb, std::size_t be) {
-          for (std::size_t b = bb; b < be; ++b) {
-            const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
-            const auto& nbr = F.grid.pblock_nbr[b];
-            for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
-              const std::uint32_t j = F.grid.order[q];
-              const QuadraticWeights W(F.grid.grid_coord(F.x0[j]));
-              const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-              Vec3 dv = Vec3::Zero();
-              Mat3 B = Mat3::Zero();
-              bool any = false;
-              for_each_stencil_node(W, bc, [&](const StencilNode& n) {
-                const int o = (n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2);
-                const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
-                const int fi = folded ? F.fold[nbr[o]] : -1;
-                // Where the shell folds, the control point reads its own class.
-                const bool second =
-                    fi >= 0 && is_split(F.folds[fi], bn) &&
-                    fold_height(F.normal[j], fx, n.i, n.j, n.k) >= F.folds[fi].cut[bn];
-                const Vec3& rn = second ? F.folds[fi].r[bn] : F.r[nbr[o]][bn];
-                if (rn.isZero()) return;
-                any = true;
-                dv += n.w * rn;
-                B += (n.w * rn) * (Vec3(Real(n.i), Real(n.j), Real(n.k)) - fx).transpose();
-              });
-              if (!any) continue;
-              // Pinned components keep their prescribed velocity, but their affine matrix
-              // still becomes the gradient of this shell's own field: left at the shared
-              // node's, a pinned sheet under a sliding block would carry the block's shear
-              // and the contact would see it moving.
-              const std::uint8_t held = gs.held[j];
-              for (int a = 0; a < 3; ++a)
-                if (held & (1u << a)) dv[a] = 0;
-              sh.v[j] += dv;
-              sh.x[j] += dt * dv;
-              gs.contact->C[j] += c_scale * B;
-            }
+        [&](std::size_t b) {
+          const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
+          const auto& nbr = F.grid.pblock_nbr[b];
+          for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
+            const std::uint32_t j = F.grid.order[q];
+            const QuadraticWeights W(F.grid.grid_coord(F.x0[j]));
+            const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
+            Vec3 dv = Vec3::Zero();
+            Mat3 B = Mat3::Zero();
+            bool any = false;
+            for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+              const int o = (n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2);
+              const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
+              const int fi = folded ? F.fold[nbr[o]] : -1;
+              // Where the shell folds, the control point reads its own class.
+              const bool second =
+                  fi >= 0 && is_split(F.folds[fi], bn) &&
+                  fold_height(F.normal[j], fx, n.i, n.j, n.k) >= F.folds[fi].cut[bn];
+              const Vec3& rn = second ? F.folds[fi].r[bn] : F.r[nbr[o]][bn];
+              if (rn.isZero()) return;
+              any = true;
+              dv += n.w * rn;
+              B += (n.w * rn) * (Vec3(Real(n.i), Real(n.j), Real(n.k)) - fx).transpose();
+            });
+            if (!any) continue;
+            // Pinned components keep their prescribed velocity, but their affine matrix
+            // still becomes the gradient of this shell's own field: left at the shared
+            // node's, a pinned sheet under a sliding block would carry the block's shear
+            // and the contact would see it moving.
+            const std::uint8_t held = gs.held[j];
+            for (int a = 0; a < 3; ++a)
+              if (held & (1u << a)) dv[a] = 0;
+            sh.v[j] += dv;
+            sh.x[j] += dt * dv;
+            gs.contact->C[j] += c_scale * B;
           }
         },
         serial);

@@ -118,7 +118,6 @@ class ShellFields {
   /// the axes, or tilted in one plane, all have a clear sign against it).
   static inline const Vec3 kAlign = Vec3(Real(0.8), Real(0.5), Real(0.33)).normalized();
   /// The second class of a shell's control points on the grid blocks where it folds.
-  /// The second class of a shell's control points on the grid blocks where it folds.
   struct FoldBlock {
     std::array<std::uint8_t, kBlockNodes> split;  ///< 1: the node has two classes
     std::array<Real, kBlockNodes> cut;            ///< class 1: fold_height >= cut
@@ -168,6 +167,30 @@ class ShellFields {
   static void mark_split_nodes(Field& F);
   void scatter_classes(Field& F, const GridShell& gs, Real dt, bool serial);
   static void gather_classes(Field& F, bool serial);
+  /// A body at a node: a shell there, or one of its two classes where it folds.
+  struct Body {
+    int shell;
+    const Node* f;
+    Vec3* r;                  ///< where its relative velocity goes
+    Vec3 vel, nrm, own, off;  ///< velocity, normal to the node, own normal, centroid
+    Real winv;                ///< inverse effective mass (pinned share: infinite)
+  };
+  // Steps of p2g().
+  /// fblock_, fielded_: each field's block at each combined grid block.
+  void find_field_blocks(const SparseGrid& combined, bool serial);
+  /// The bodies with mass at node n of combined grid block g (velocities only); returns
+  /// their total mass.
+  Real node_bodies(std::size_t g, int n, std::vector<Body>& bodies);
+  /// A body's normals, centroid offset and inverse effective mass from its sums.
+  static void body_geometry(Body& B);
+  /// Shell against shell at one node (facing across it, or stacked on one side).
+  void shell_pairs(std::vector<Body>& bodies) const;
+  /// Each shell against the bulk field (mass mk, velocity vk; bm its centroid, or null).
+  void bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk) const;
+  /// Bardenhagen's rule at node n of combined grid block g (combined node cn): the
+  /// bodies' and the bulk field's velocities relative to the node's, and its shared_ bit.
+  void resolve_node(const GridNode& cn, std::size_t g, int n, bool moments,
+                    std::vector<Body>& bodies);
   /// Bulk mass centroids on the grid blocks where shells have fields.
   void bulk_moments(const SparseGrid& combined, const ParticleSet& bulk, std::uint32_t first_bulk,
                     bool serial);

@@ -71,29 +71,27 @@ void ShellFields::scatter_classes(Field& F, const GridShell& gs, Real dt, bool s
     }
   F.class_buf.resize(num_touched);
 
-  parallel_for(
+  parallel_for_each(
       nb, 1,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          if (F.touched[b] < 0) continue;
-          auto& buf = F.class_buf[F.touched[b]];
-          for (Classes& c : buf) Node::clear(c.c, 2);
-          const Vec3i bc = unpack_block(G.pblock_key[b]) * kBlockSize;
-          const auto& nbr = G.pblock_nbr[b];
-          for (std::uint32_t q = G.pblock_start[b]; q < G.pblock_start[b + 1]; ++q) {
-            const std::uint32_t j = G.order[q];
-            const QuadraticWeights W(G.grid_coord(sh.x[j]));
-            const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, true);
-            for_each_stencil_node(W, bc, [&](const StencilNode& n) {
-              const int g = nbr[(n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2)];
-              if (g < 0 || F.fold[g] < 0) return;
-              const FoldBlock& fb = F.folds[F.fold[g]];
-              const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
-              if (!is_split(fb, bn)) return;
-              const int c = fold_height(P.n, P.fx, n.i, n.j, n.k) >= fb.cut[bn] ? 1 : 0;
-              P.add(buf[n.pad()].c[c], n.w, n.i, n.j, n.k);
-            });
-          }
+      [&](std::size_t b) {
+        if (F.touched[b] < 0) return;
+        auto& buf = F.class_buf[F.touched[b]];
+        for (Classes& c : buf) Node::clear(c.c, 2);
+        const Vec3i bc = unpack_block(G.pblock_key[b]) * kBlockSize;
+        const auto& nbr = G.pblock_nbr[b];
+        for (std::uint32_t q = G.pblock_start[b]; q < G.pblock_start[b + 1]; ++q) {
+          const std::uint32_t j = G.order[q];
+          const QuadraticWeights W(G.grid_coord(sh.x[j]));
+          const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, true);
+          for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+            const int g = nbr[(n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2)];
+            if (g < 0 || F.fold[g] < 0) return;
+            const FoldBlock& fb = F.folds[F.fold[g]];
+            const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
+            if (!is_split(fb, bn)) return;
+            const int c = fold_height(P.n, P.fx, n.i, n.j, n.k) >= fb.cut[bn] ? 1 : 0;
+            P.add(buf[n.pad()].c[c], n.w, n.i, n.j, n.k);
+          });
         }
       },
       serial);

@@ -160,20 +160,17 @@ void ShellGuard::build_shell_candidates(double radius) {
   const std::size_t grain = 512;
   const auto chunked = [&](std::size_t n, std::size_t stamps, std::vector<Eigen::Vector2i>& out,
                            const auto& visit) {
-    const std::size_t chunks = (n + grain - 1) / grain;
-    std::vector<std::vector<Eigen::Vector2i>> parts(chunks);
-    parallel_for(
-        n, grain,
-        [&](std::size_t b, std::size_t e) {
-          std::vector<int> stamp(stamps, -1), cand;
-          for (std::size_t i = b; i < e; ++i) {
-            cand.clear();
-            visit(i, stamp, cand);
-            std::sort(cand.begin(), cand.end());
-            for (int f : cand) parts[b / grain].emplace_back(static_cast<int>(i), f);
-          }
-        },
-        serial_);
+    const auto parts =
+        chunk_parts(n, grain, serial_, std::vector<Eigen::Vector2i>(),
+                    [&](std::size_t b, std::size_t e, std::vector<Eigen::Vector2i>& part) {
+                      std::vector<int> stamp(stamps, -1), cand;
+                      for (std::size_t i = b; i < e; ++i) {
+                        cand.clear();
+                        visit(i, stamp, cand);
+                        std::sort(cand.begin(), cand.end());
+                        for (int f : cand) part.emplace_back(static_cast<int>(i), f);
+                      }
+                    });
     for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
   };
   chunked(pos_.size(), all_tris_.size(), vt_cand_,
@@ -241,12 +238,10 @@ void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, dou
   // Chunks of particles on the threads, each with its own stamps and (particle,
   // triangle) pairs, joined in order.
   const std::size_t grain = 4096, n = ps->size();
-  std::vector<std::vector<std::pair<std::uint32_t, int>>> parts((n + grain - 1) / grain);
-  parallel_for(
-      n, grain,
-      [&](std::size_t b, std::size_t e) {
+  using Pairs = std::vector<std::pair<std::uint32_t, int>>;
+  const std::vector<Pairs> parts =
+      chunk_parts(n, grain, serial_, Pairs(), [&](std::size_t b, std::size_t e, Pairs& out) {
         std::vector<int> stamp(all_tris_.size(), -1), cand;
-        auto& out = parts[b / grain];
         for (std::size_t p = b; p < e; ++p) {
           const Vec3d x = to_d(ps->x[p]) - dt * to_d(ps->v[p]);
           if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
@@ -263,8 +258,7 @@ void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, dou
           std::sort(cand.begin(), cand.end());
           for (int t : cand) out.emplace_back(static_cast<std::uint32_t>(p), t);
         }
-      },
-      serial_);
+      });
   for (const auto& part : parts)
     for (const auto& [p, t] : part) {
       if (bulk_idx_.empty() || bulk_idx_.back() != p) bulk_idx_.push_back(p);
@@ -371,15 +365,9 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
   return apply(shells, start, bulk, dt);
 }
 
-ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
-                                  const std::vector<std::vector<Vec3>>& start,
-                                  const GuardBulk& bulk, double dt) {
-  ShellGuardStats st;
-  if (meshes_.empty() || !(dt > 0)) return st;
-  const std::size_t np = point_offset_.back(), nv = vertex_offset_.back();
-  // Control points: start-of-step positions, and the velocity that takes them to where
-  // they are now ((x - x^n) / dt: G2P's velocity, plus a collider's projection where one
-  // moved the point), which the constraints act on.
+double ShellGuard::load_points(const std::vector<GridShell>& shells,
+                               const std::vector<std::vector<Vec3>>& start, double dt) {
+  const std::size_t np = point_offset_.back();
   v_.resize(np);
   v_end_.resize(np);
   inv_mass_.resize(np);
@@ -397,30 +385,11 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
       for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
     }
   }
-  // Speed bounds: the limit vertices are convex combinations of the control points (Loop
-  // limit weights are positive), so the largest control-point speed bounds theirs.
-  ParticleSet* const ps = bulk.particles;
-  const std::size_t nb = ps ? ps->size() : 0;
-  double vbulk = 0;
-  for (std::size_t p = 0; p < nb; ++p)
-    vbulk = std::max(vbulk, static_cast<double>(ps->v[p].norm()));
-  if (!std::isfinite(vmax) || !std::isfinite(vbulk)) return st;  // diverged: the solver says so
-  // Relative motion bounds this step: shell against shell, bulk against shell.
-  const double reach = 2.0 * vmax * dt, reach_bulk = dt * (vmax + vbulk);
-  const double r = gap_ + reach, r_bulk = gap_ + reach_bulk;
-  // Candidate lists, rebuilt when the motion since the last build could bring a pair
-  // left out within reach (a pair left out was at least gap + margin apart then), and
-  // the bulk list also when the particles were reordered or added.
-  const bool shell_rebuild = !shell_list_.valid(reach);
-  const bool bulk_rebuild =
-      nb > 0 && (!bulk_list_.valid(reach_bulk) || bulk.epoch != built_epoch_ || nb != built_count_);
-  if (nb == 0) bt_cand_.clear(), bulk_idx_.clear();
-  shell_list_.moved += reach;
-  bulk_list_.moved += reach_bulk;
-  if (!shell_rebuild && !bulk_rebuild && vt_cand_.empty() && ee_cand_.empty() && bt_cand_.empty())
-    return st;  // nothing near, and the lists still hold
-  // Limit vertices at x^n.
-  pos_.assign(nv, Vec3d::Zero());
+  return vmax;
+}
+
+void ShellGuard::limit_positions() {
+  pos_.assign(vertex_offset_.back(), Vec3d::Zero());
   for (std::size_t s = 0; s < meshes_.size(); ++s) {
     const LimitMesh& L = *meshes_[s].limit;
     for (std::size_t row = 0; row < L.num_vertices(); ++row) {
@@ -432,30 +401,26 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
             static_cast<double>(w[k]) * x0_[point_offset_[s] + static_cast<std::size_t>(pts[k])];
     }
   }
-  if (shell_rebuild) {
-    shell_list_.start(gap_, reach);
-    build_shell_candidates(gap_ + shell_list_.margin);
-  }
-  if (bulk_rebuild) {
-    bulk_list_.start(gap_, reach_bulk);
-    build_bulk_candidates(gap_ + bulk_list_.margin, bulk, dt);
-    built_epoch_ = bulk.epoch;
-    built_count_ = nb;
-  }
-  // The bulk candidates join the unknowns after the control points.
-  const std::size_t nbk = bulk_idx_.size();
+}
+
+void ShellGuard::load_bulk(const GuardBulk& bulk, double dt) {
+  const ParticleSet& ps = *bulk.particles;
+  const std::size_t np = point_offset_.back(), nbk = bulk_idx_.size();
   v_.resize(np + nbk);
   inv_mass_.resize(np + nbk);
   bulk_x0_.resize(nbk);
   for (std::size_t k = 0; k < nbk; ++k) {
     const std::size_t p = bulk_idx_[k];
-    v_[np + k] = to_d(ps->v[p]);
-    bulk_x0_[k] = to_d(ps->x[p]) - dt * v_[np + k];
-    const double m = static_cast<double>(ps->volume[p]) *
-                     static_cast<double>((*bulk.densities)[ps->material[p]]);
+    v_[np + k] = to_d(ps.v[p]);
+    bulk_x0_[k] = to_d(ps.x[p]) - dt * v_[np + k];
+    const double m =
+        static_cast<double>(ps.volume[p]) * static_cast<double>((*bulk.densities)[ps.material[p]]);
     inv_mass_[np + k] = Vec3d::Constant(m > 0 ? 1.0 / m : 0.0);
   }
+}
 
+void ShellGuard::gather_pairs(double r, double r_bulk, double dt) {
+  const std::size_t np = point_offset_.back();
   entries_.clear();
   pairs_.clear();
   const auto local = [&](std::size_t g) {
@@ -509,13 +474,12 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
     for (int q = 0; q < 3; ++q) add_vertex(vert_shell_[T[q]], local(T[q]), -w[q]);
     add_pair(n, d, dt);
   }
-  st.pairs = pairs_.size();
-  if (pairs_.empty()) return st;
+}
 
-  // Projected Gauss-Seidel on the accumulated impulses (lambda >= 0).
-  const double tol = 1e-4 * gap_ / dt;
+int ShellGuard::solve_pairs(double tol) {
+  int sweeps = 0;
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-    st.sweeps = sweep + 1;
+    sweeps = sweep + 1;
     double change = 0;
     for (Pair& p : pairs_) {
       if (!(p.denom > 0)) continue;
@@ -531,13 +495,11 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
     }
     if (change <= tol) break;
   }
-  for (const Pair& p : pairs_)
-    if (p.lambda > 0) ++st.impulses;
-  st.zoned = impact_zones(tol);
-  for (const Pair& p : pairs_)
-    if (p.target - rate(p) > tol) ++st.unresolved;
-  if (st.impulses == 0 && st.zoned == 0) return st;
-  // Write back: the change of each velocity, and the position moves by dt times it.
+  return sweeps;
+}
+
+void ShellGuard::write_back(std::vector<GridShell>& shells, ParticleSet* ps, double dt) const {
+  // The change of each velocity, and the position moves by dt times it.
   for (std::size_t s = 0; s < shells.size(); ++s) {
     ShellObject& sh = *shells[s].shell;
     for (std::size_t j = 0; j < sh.size(); ++j) {
@@ -550,7 +512,8 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
       }
     }
   }
-  for (std::size_t k = 0; k < nbk; ++k) {
+  const std::size_t np = point_offset_.back();
+  for (std::size_t k = 0; k < bulk_idx_.size(); ++k) {
     const std::size_t p = bulk_idx_[k];
     const Vec3 vn = v_[np + k].cast<Real>();
     for (int a = 0; a < 3; ++a) {
@@ -559,6 +522,65 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
       ps->v[p][a] = vn[a];
     }
   }
+}
+
+ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
+                                  const std::vector<std::vector<Vec3>>& start,
+                                  const GuardBulk& bulk, double dt) {
+  ShellGuardStats st;
+  if (meshes_.empty() || !(dt > 0)) return st;
+  // Control points: start-of-step positions, and the velocity that takes them to where
+  // they are now ((x - x^n) / dt: G2P's velocity, plus a collider's projection where one
+  // moved the point), which the constraints act on.
+  const double vmax = load_points(shells, start, dt);
+  // Speed bounds: the limit vertices are convex combinations of the control points (Loop
+  // limit weights are positive), so the largest control-point speed bounds theirs.
+  ParticleSet* const ps = bulk.particles;
+  const std::size_t nb = ps ? ps->size() : 0;
+  double vbulk = 0;
+  for (std::size_t p = 0; p < nb; ++p)
+    vbulk = std::max(vbulk, static_cast<double>(ps->v[p].norm()));
+  if (!std::isfinite(vmax) || !std::isfinite(vbulk)) return st;  // diverged: the solver says so
+  // Relative motion bounds this step: shell against shell, bulk against shell.
+  const double reach = 2.0 * vmax * dt, reach_bulk = dt * (vmax + vbulk);
+  const double r = gap_ + reach, r_bulk = gap_ + reach_bulk;
+  // Candidate lists, rebuilt when the motion since the last build could bring a pair
+  // left out within reach (a pair left out was at least gap + margin apart then), and
+  // the bulk list also when the particles were reordered or added.
+  const bool shell_rebuild = !shell_list_.valid(reach);
+  const bool bulk_rebuild =
+      nb > 0 && (!bulk_list_.valid(reach_bulk) || bulk.epoch != built_epoch_ || nb != built_count_);
+  if (nb == 0) bt_cand_.clear(), bulk_idx_.clear();
+  shell_list_.moved += reach;
+  bulk_list_.moved += reach_bulk;
+  if (!shell_rebuild && !bulk_rebuild && vt_cand_.empty() && ee_cand_.empty() && bt_cand_.empty())
+    return st;        // nothing near, and the lists still hold
+  limit_positions();  // at x^n
+  if (shell_rebuild) {
+    shell_list_.start(gap_, reach);
+    build_shell_candidates(gap_ + shell_list_.margin);
+  }
+  if (bulk_rebuild) {
+    bulk_list_.start(gap_, reach_bulk);
+    build_bulk_candidates(gap_ + bulk_list_.margin, bulk, dt);
+    built_epoch_ = bulk.epoch;
+    built_count_ = nb;
+  }
+  if (nb > 0) load_bulk(bulk, dt);  // the bulk candidates join the unknowns
+  gather_pairs(r, r_bulk, dt);
+  st.pairs = pairs_.size();
+  if (pairs_.empty()) return st;
+
+  // Projected Gauss-Seidel on the accumulated impulses (lambda >= 0).
+  const double tol = 1e-4 * gap_ / dt;
+  st.sweeps = solve_pairs(tol);
+  for (const Pair& p : pairs_)
+    if (p.lambda > 0) ++st.impulses;
+  st.zoned = impact_zones(tol);
+  for (const Pair& p : pairs_)
+    if (p.target - rate(p) > tol) ++st.unresolved;
+  if (st.impulses == 0 && st.zoned == 0) return st;
+  write_back(shells, ps, dt);
   return st;
 }
 

@@ -125,6 +125,22 @@ class ShellGuard {
   /// Bulk particle-triangle pairs closer than radius (particles at x^n, sorted).
   void build_bulk_candidates(double radius, const GuardBulk& bulk, double dt);
   double cell_size(double radius) const;
+  // Steps of apply(), in order.
+  /// x0_, v_ = v_end_ = (x - x^n) / dt and inv_mass_ of the control points; returns the
+  /// largest control-point speed.
+  double load_points(const std::vector<GridShell>& shells,
+                     const std::vector<std::vector<Vec3>>& start, double dt);
+  /// pos_: the limit vertices at x0_.
+  void limit_positions();
+  /// The bulk candidates' velocities, inverse masses and x^n after the control points.
+  void load_bulk(const GuardBulk& bulk, double dt);
+  /// entries_, pairs_: the candidates within r (shell) and r_bulk (bulk) at x^n.
+  void gather_pairs(double r, double r_bulk, double dt);
+  /// Projected Gauss-Seidel on the pairs' impulses until a sweep changes less than tol
+  /// [m/s]; returns the sweeps done.
+  int solve_pairs(double tol);
+  /// Adds the velocity changes to the shells' and particles' v, and dt times them to x.
+  void write_back(std::vector<GridShell>& shells, ParticleSet* ps, double dt) const;
   /// A Verlet list's schedule: valid while the motion bound since its build stays
   /// within its margin.
   struct ListSchedule {

@@ -110,23 +110,19 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
       sh.x[j] += dt * sh.v[j];
     } else {
       ShellContact& c = *gs.contact;
-      auto node = [&](int i, int jj, int k) -> const GridNode& {
-        return buf[pad_node(i - bc[0], jj - bc[1], k - bc[2])];
-      };
+      const QuadraticWeights W(grid.grid_coord(c.x[j]));
       const SiteMoments sm =
-          site_moments(grid, c.x[j], [&](int i, int jj, int k) { return node(i, jj, k).m; });
+          site_moments(W, dx, bc, [&](const StencilNode& n) { return buf[n.pad()].m; });
       if (!sm.any) continue;
       // grad~v a3E = sum_n v_n (g_n . a3E); nodes without mass have g_n = 0.
       Real ga[27];
       sm.dot(c.a3e[j], ga);
       Vec3 gradv_a3 = Vec3::Zero();
       int n = 0;
-      for (int i = 0; i < 3; ++i)
-        for (int jj = 0; jj < 3; ++jj) {
-          const GridNode* row = &node(sm.base[0] + i, sm.base[1] + jj, sm.base[2]);
-          for (int k = 0; k < 3; ++k, ++n)
-            gradv_a3 += ga[n] * Vec3(row[k].v[0], row[k].v[1], row[k].v[2]);
-        }
+      for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
+        const GridNode& node = buf[nd.pad()];
+        gradv_a3 += ga[n++] * Vec3(node.v[0], node.v[1], node.v[2]);
+      });
       c.a3e[j] += dt * gradv_a3;
     }
   }
@@ -137,44 +133,40 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
   const std::uint32_t nc = table.num_control_points();
   const auto ns = static_cast<std::uint32_t>(table.size());
   grid.scatter_grid_to_buffers(serial);
-  parallel_for(
+  parallel_for_each(
       grid.num_particle_blocks(), 1,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          auto& buf = grid.pblock_buf[b];
-          const auto [lo, hi] = slice(grid, b, nc, ns);
-          Real mass[kPadNodes];
-          for (int n = 0; n < kPadNodes; ++n) mass[n] = buf[n].m;
-          std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
-          if (lo == hi) continue;
-          const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
-          for (std::uint32_t s = lo; s < hi; ++s) {
-            const std::uint32_t g = grid.order[s];
-            const ShellContact& c = *shells[table.shell(g)].contact;
-            const std::uint32_t p = table.local(g);
-            const Vec3& G3 = c.G3[p];
-            if (G3.squaredNorm() == 0) continue;
-            auto at = [&](int i, int j, int k) {
-              return pad_node(i - bc[0], j - bc[1], k - bc[2]);
-            };
-            const SiteMoments sm =
-                site_moments(grid, c.x[p], [&](int i, int j, int k) { return mass[at(i, j, k)]; });
-            if (!sm.any) continue;
-            Real ga[27];
-            sm.dot(c.a3e[p], ga);
-            const Real s0 = -dt * c.volume[p];
-            int n = 0;
-            for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j)
-                for (int k = 0; k < 3; ++k, ++n) {
-                  if (!sm.massive[n]) continue;
-                  const int id = at(sm.base[0] + i, sm.base[1] + j, sm.base[2] + k);
-                  const Vec3 dv = (s0 * ga[n] / mass[id]) * G3;
-                  buf[id].v[0] += dv[0];
-                  buf[id].v[1] += dv[1];
-                  buf[id].v[2] += dv[2];
-                }
-          }
+      [&](std::size_t b) {
+        auto& buf = grid.pblock_buf[b];
+        const auto [lo, hi] = slice(grid, b, nc, ns);
+        Real mass[kPadNodes];
+        for (int n = 0; n < kPadNodes; ++n) mass[n] = buf[n].m;
+        std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
+        if (lo == hi) return;
+        const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
+        const Real dx = static_cast<Real>(grid.dx());
+        for (std::uint32_t s = lo; s < hi; ++s) {
+          const std::uint32_t g = grid.order[s];
+          const ShellContact& c = *shells[table.shell(g)].contact;
+          const std::uint32_t p = table.local(g);
+          const Vec3& G3 = c.G3[p];
+          if (G3.squaredNorm() == 0) continue;
+          const QuadraticWeights W(grid.grid_coord(c.x[p]));
+          const SiteMoments sm =
+              site_moments(W, dx, bc, [&](const StencilNode& n) { return mass[n.pad()]; });
+          if (!sm.any) continue;
+          Real ga[27];
+          sm.dot(c.a3e[p], ga);
+          const Real s0 = -dt * c.volume[p];
+          int n = 0;
+          for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
+            const int k = n++;
+            if (!sm.massive[k]) return;
+            const int id = nd.pad();
+            const Vec3 dv = (s0 * ga[k] / mass[id]) * G3;
+            buf[id].v[0] += dv[0];
+            buf[id].v[1] += dv[1];
+            buf[id].v[2] += dv[2];
+          });
         }
       },
       serial);

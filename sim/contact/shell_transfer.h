@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "sim/contact/shell_contact.h"
+#include "sim/mpm/apic_stencil.h"
 #include "sim/mpm/bspline.h"
 #include "sim/mpm/sparse_grid.h"
 #include "sim/shell/shell_object.h"
@@ -98,30 +99,28 @@ struct SiteMoments {
     }
   }
 };
-/// mass(i, j, k): mass of the node with global grid index (i, j, k).
+/// The moments of the point with weights W on a grid of spacing dx [m]. The stencil is
+/// walked with for_each_stencil_node(W, block_corner, ...) (sim/mpm/apic_stencil.h);
+/// mass(const StencilNode&) gives the mass of a node.
 template <class MassFn>
-SiteMoments site_moments(const SparseGrid& grid, const Vec3& x, MassFn mass) {
+SiteMoments site_moments(const QuadraticWeights& W, Real dx, const Vec3i& block_corner,
+                         MassFn mass) {
   SiteMoments sm;
-  const QuadraticWeights W(grid.grid_coord(x));
-  const Real dx = static_cast<Real>(grid.dx());
   for (int a = 0; a < 3; ++a) sm.base[a] = W.base[a];
   // Two-axis marginals of a: Aij = sum_k a, Aik = sum_j a, Ajk = sum_i a.
   Real Aij[3][3] = {}, Aik[3][3] = {}, Ajk[3][3] = {};
   int n = 0;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      const Real wxy = W.w[0][i] * W.w[1][j];
-      for (int k = 0; k < 3; ++k, ++n) {
-        sm.w[n] = wxy * W.w[2][k];
-        const Real m = mass(W.base[0] + i, W.base[1] + j, W.base[2] + k);
-        sm.massive[n] = m > 0;
-        const Real an = sm.massive[n] ? sm.w[n] * m : Real(0);
-        sm.a[n] = an;
-        Aij[i][j] += an;
-        Aik[i][k] += an;
-        Ajk[j][k] += an;
-      }
-    }
+  for_each_stencil_node(W, block_corner, [&](const StencilNode& nd) {
+    sm.w[n] = nd.w;
+    const Real m = mass(nd);
+    sm.massive[n] = m > 0;
+    const Real an = sm.massive[n] ? sm.w[n] * m : Real(0);
+    sm.a[n] = an;
+    Aij[nd.i][nd.j] += an;
+    Aik[nd.i][nd.k] += an;
+    Ajk[nd.j][nd.k] += an;
+    ++n;
+  });
   Real A[3][3];  // one-axis marginals A[axis][o]
   for (int o = 0; o < 3; ++o) {
     A[0][o] = Aij[o][0] + Aij[o][1] + Aij[o][2];
@@ -170,7 +169,11 @@ struct SiteStencil {
 /// mass(i, j, k): mass of the node with global grid index (i, j, k).
 template <class MassFn>
 SiteStencil site_stencil(const SparseGrid& grid, const Vec3& x, MassFn mass) {
-  const SiteMoments sm = site_moments(grid, x, mass);
+  const QuadraticWeights W(grid.grid_coord(x));
+  const Vec3i base(W.base[0], W.base[1], W.base[2]);
+  const SiteMoments sm = site_moments(
+      W, static_cast<Real>(grid.dx()), base,
+      [&](const StencilNode& n) { return mass(base[0] + n.i, base[1] + n.j, base[2] + n.k); });
   SiteStencil st;
   for (int a = 0; a < 3; ++a) st.base[a] = sm.base[a];
   for (int n = 0; n < 27; ++n) {

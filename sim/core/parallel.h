@@ -44,16 +44,27 @@ void parallel_for_each(std::size_t n, std::size_t grain, Body&& body, bool seria
       serial);
 }
 
-/// Combines chunk(b, e), the partial result of each chunk [b, e) of `grain` items, in
-/// chunk order starting from `zero`: the same result for any thread count.
-/// T needs operator+=.
+/// The deterministic reduction every parallel sum, maximum or list goes through: runs
+/// chunk(b, e, part) for each chunk [b, e) of `grain` items, each on its own `part` (a
+/// copy of `zero`), and returns the parts in chunk order, for the caller to merge in
+/// that order: the same result for any thread count.
 template <class T, class Chunk>
-T ordered_reduce_chunks(std::size_t n, std::size_t grain, bool serial, const T& zero,
-                        Chunk&& chunk) {
+std::vector<T> chunk_parts(std::size_t n, std::size_t grain, bool serial, const T& zero,
+                           Chunk&& chunk) {
   grain = std::max<std::size_t>(grain, 1);
   std::vector<T> part((n + grain - 1) / grain, zero);
   parallel_for(
-      n, grain, [&](std::size_t b, std::size_t e) { part[b / grain] = chunk(b, e); }, serial);
+      n, grain, [&](std::size_t b, std::size_t e) { chunk(b, e, part[b / grain]); }, serial);
+  return part;
+}
+
+/// Combines chunk(b, e), the partial result of each chunk [b, e) of `grain` items, in
+/// chunk order starting from `zero` (chunk_parts). T needs operator+=.
+template <class T, class Chunk>
+T ordered_reduce_chunks(std::size_t n, std::size_t grain, bool serial, const T& zero,
+                        Chunk&& chunk) {
+  const std::vector<T> part = chunk_parts(
+      n, grain, serial, zero, [&](std::size_t b, std::size_t e, T& out) { out = chunk(b, e); });
   T total = zero;
   for (const T& v : part) total += v;
   return total;

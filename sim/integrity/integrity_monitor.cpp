@@ -1,6 +1,7 @@
 #include "sim/integrity/integrity_monitor.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -30,17 +31,17 @@ struct Tally {
   }
 };
 
-void merge(const std::vector<Tally>& parts, std::vector<std::size_t>& count,
-           std::vector<Vec3d>& where, std::vector<int>* from) {
-  for (const Tally& t : parts)
-    for (std::size_t s = 0; s < count.size(); ++s) {
-      if (t.count[s] == 0) continue;
-      if (count[s] == 0) {
-        where[s] = t.where[s];
-        if (from) (*from)[s] = t.from[s];
-      }
-      count[s] += t.count[s];
+/// Adds a chunk's tally t to the totals (the first place seen is kept).
+void merge(const Tally& t, std::vector<std::size_t>& count, std::vector<Vec3d>& where,
+           std::vector<int>* from) {
+  for (std::size_t s = 0; s < count.size(); ++s) {
+    if (t.count[s] == 0) continue;
+    if (count[s] == 0) {
+      where[s] = t.where[s];
+      if (from) (*from)[s] = t.from[s];
     }
+    count[s] += t.count[s];
+  }
 }
 
 }  // namespace
@@ -168,37 +169,37 @@ void IntegrityMonitor::compare(const IntegrityView& view, bool record_only) {
   }
   ++checks_;
   const std::size_t K = shells_.size();
-  const std::size_t chunks = (n + kGrain - 1) / kGrain;
-  std::vector<Tally> bulk(chunks, Tally(K)), pts(chunks, Tally(K));
-  parallel_for(
-      n, kGrain,
-      [&](std::size_t b, std::size_t e) {
-        Tally& tb = bulk[b / kGrain];
-        Tally& tp = pts[b / kGrain];
-        std::size_t s = 0;
-        for (std::size_t i = b; i < e; ++i) {
-          const Vec3d x = point(view, i, s);
-          const int own = i < nv ? static_cast<int>(s) : -1;
-          const Hit h = side_of(x, own);
-          if (h.side == Side::Far || h.side == Side::Rim) {
-            rec_shell_[i] = -1;
-            continue;
-          }
-          if (h.side == Side::Dead) continue;
-          const auto side = static_cast<std::int8_t>(h.side);
-          if (!record_only && rec_shell_[i] == h.shell && rec_side_[i] == -side) {
-            if (own < 0)
-              tb.add(h.shell, x, -1);
-            else
-              tp.add(h.shell, x, own);
-          }
-          rec_shell_[i] = static_cast<std::int16_t>(h.shell);
-          rec_side_[i] = side;
-        }
-      },
-      view.serial);
-  merge(bulk, bulk_cross_, bulk_where_, nullptr);
-  merge(pts, point_cross_, point_where_, &point_from_);
+  // Per chunk: bulk particles, then shell points, that crossed a shell.
+  const std::vector<std::array<Tally, 2>> parts =
+      chunk_parts(n, kGrain, view.serial, std::array<Tally, 2>{Tally(K), Tally(K)},
+                  [&](std::size_t b, std::size_t e, std::array<Tally, 2>& tally) {
+                    Tally& tb = tally[0];
+                    Tally& tp = tally[1];
+                    std::size_t s = 0;
+                    for (std::size_t i = b; i < e; ++i) {
+                      const Vec3d x = point(view, i, s);
+                      const int own = i < nv ? static_cast<int>(s) : -1;
+                      const Hit h = side_of(x, own);
+                      if (h.side == Side::Far || h.side == Side::Rim) {
+                        rec_shell_[i] = -1;
+                        continue;
+                      }
+                      if (h.side == Side::Dead) continue;
+                      const auto side = static_cast<std::int8_t>(h.side);
+                      if (!record_only && rec_shell_[i] == h.shell && rec_side_[i] == -side) {
+                        if (own < 0)
+                          tb.add(h.shell, x, -1);
+                        else
+                          tp.add(h.shell, x, own);
+                      }
+                      rec_shell_[i] = static_cast<std::int16_t>(h.shell);
+                      rec_side_[i] = side;
+                    }
+                  });
+  for (const std::array<Tally, 2>& t : parts) {
+    merge(t[0], bulk_cross_, bulk_where_, nullptr);
+    merge(t[1], point_cross_, point_where_, &point_from_);
+  }
 }
 
 void IntegrityMonitor::begin_frame(const IntegrityView& view) {
@@ -309,13 +310,9 @@ void IntegrityMonitor::check_crossings(const IntegrityView& view, IntegrityRepor
         const bool self = a == b;
         const auto& T = tb.limit->triangles();
         const std::size_t ne = ea.edges.size();
-        const std::size_t chunks = (ne + kGrain - 1) / kGrain;
-        std::vector<Tally> parts(chunks, Tally(1));
-        parallel_for(
-            ne, kGrain,
-            [&](std::size_t eb, std::size_t ee) {
+        const std::vector<Tally> parts = chunk_parts(
+            ne, kGrain, view.serial, Tally(1), [&](std::size_t eb, std::size_t ee, Tally& tl) {
               std::vector<int> cand;
-              Tally& tl = parts[eb / kGrain];
               for (std::size_t i = eb; i < ee; ++i) {
                 const auto [u, v] = ea.edges[i];
                 const Vec3d& p = ea.pos[u];
@@ -333,8 +330,7 @@ void IntegrityMonitor::check_crossings(const IntegrityView& view, IntegrityRepor
                   }
                 }
               }
-            },
-            view.serial);
+            });
         for (const Tally& t : parts) {
           if (t.count[0] && count == 0) where = t.where[0];
           count += t.count[0];
@@ -394,12 +390,8 @@ void IntegrityMonitor::check_collider(const IntegrityView& view, const Collider&
   };
   const std::size_t nv = vertex_offset_.back();
   const std::size_t n = nv + nb;
-  const std::size_t chunks = (n + kGrain - 1) / kGrain;
-  std::vector<Deep> parts(chunks);
-  parallel_for(
-      n, kGrain,
-      [&](std::size_t b, std::size_t e) {
-        Deep& d = parts[b / kGrain];
+  const std::vector<Deep> parts =
+      chunk_parts(n, kGrain, view.serial, Deep(), [&](std::size_t b, std::size_t e, Deep& d) {
         std::size_t s = 0;
         for (std::size_t i = b; i < e; ++i) {
           const Vec3d x = point(view, i, s);
@@ -413,8 +405,7 @@ void IntegrityMonitor::check_collider(const IntegrityView& view, const Collider&
           }
           if (depth > r.collider_limit) ++d.count;
         }
-      },
-      view.serial);
+      });
   Deep total;
   for (const Deep& d : parts) {
     total.count += d.count;

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "sim/core/check.h"
+#include "sim/core/counting_sort.h"
 #include "sim/core/parallel.h"
 
 namespace shellmpm {
@@ -42,16 +43,9 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
     pblock_of_[p] = static_cast<std::uint32_t>(last_id);
   }
   const std::size_t nb = pblock_key.size();
-  // Stable counting sort of particle indices by particle block.
-  pblock_start.assign(nb + 1, 0);
-  for (std::size_t p = 0; p < n; ++p) ++pblock_start[pblock_of_[p] + 1];
-  for (std::size_t b = 0; b < nb; ++b) pblock_start[b + 1] += pblock_start[b];
-  order.resize(n);
-  {
-    std::vector<std::uint32_t> cursor(pblock_start.begin(), pblock_start.end() - 1);
-    for (std::size_t p = 0; p < n; ++p)
-      order[cursor[pblock_of_[p]]++] = static_cast<std::uint32_t>(p);
-  }
+  // Particle indices by particle block.
+  counting_sort(
+      n, nb, [&](std::size_t p) { return pblock_of_[p]; }, pblock_start, order);
   // Grid blocks: every particle block and its +1 neighbours.
   ghash_.clear();
   gblock_key.clear();
@@ -86,39 +80,35 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
 }
 
 void SparseGrid::gather(bool with_mass, bool serial) {
-  parallel_for(
+  parallel_for_each(
       gblock_key.size(), 4,
-      [&](std::size_t gb, std::size_t ge) {
-        for (std::size_t g = gb; g < ge; ++g) {
-          auto& nodes = gblock_nodes[g];
-          for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
-            const GridNode& from = pblock_buf[src][sn];
-            GridNode& d = nodes[dn];
-            if (with_mass) d.m += from.m;
-            d.v[0] += from.v[0];
-            d.v[1] += from.v[1];
-            d.v[2] += from.v[2];
-          });
-        }
+      [&](std::size_t g) {
+        auto& nodes = gblock_nodes[g];
+        for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
+          const GridNode& from = pblock_buf[src][sn];
+          GridNode& d = nodes[dn];
+          if (with_mass) d.m += from.m;
+          d.v[0] += from.v[0];
+          d.v[1] += from.v[1];
+          d.v[2] += from.v[2];
+        });
       },
       serial);
 }
 
 void SparseGrid::scatter_grid_to_buffers(bool serial) {
-  parallel_for(
+  parallel_for_each(
       pblock_key.size(), 4,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          auto& buf = pblock_buf[b];
-          for (int o = 0; o < 8; ++o) {
-            const auto& nodes = gblock_nodes[pblock_nbr[b][o]];
-            const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
-            const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
-            for (int i = 0; i < ix1; ++i)
-              for (int j = 0; j < iy1; ++j)
-                for (int k = 0; k < iz1; ++k)
-                  buf[pad_node(i + ox, j + oy, k + oz)] = nodes[block_node(i, j, k)];
-          }
+      [&](std::size_t b) {
+        auto& buf = pblock_buf[b];
+        for (int o = 0; o < 8; ++o) {
+          const auto& nodes = gblock_nodes[pblock_nbr[b][o]];
+          const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
+          const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
+          for (int i = 0; i < ix1; ++i)
+            for (int j = 0; j < iy1; ++j)
+              for (int k = 0; k < iz1; ++k)
+                buf[pad_node(i + ox, j + oy, k + oz)] = nodes[block_node(i, j, k)];
         }
       },
       serial);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <type_traits>
 
 #include "sim/core/parallel.h"
 #include "sim/mpm/apic_stencil.h"
@@ -102,38 +103,34 @@ void g2p_block(ParticleSet& p, SparseGrid& grid, const TransferParams& tp, std::
   }
 }
 
+/// For every particle block b in parallel: block(b, kMls) with the scheme's flag (APIC or
+/// MLS), then tp.others on the block's buffer.
+template <class Block>
+void each_particle_block(SparseGrid& grid, const TransferParams& tp, Block&& block) {
+  parallel_for_each(
+      grid.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        if (tp.mls)
+          block(b, std::true_type());
+        else
+          block(b, std::false_type());
+        if (tp.others) tp.others(b, grid.pblock_buf[b].data());
+      },
+      tp.serial);
+}
+
 }  // namespace
 
 void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp) {
-  parallel_for(
-      grid.num_particle_blocks(), 1,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          if (tp.mls)
-            p2g_block<true>(p, grid, tp, b);
-          else
-            p2g_block<false>(p, grid, tp, b);
-          if (tp.others) tp.others(b, grid.pblock_buf[b].data());
-        }
-      },
-      tp.serial);
+  each_particle_block(
+      grid, tp, [&](std::size_t b, auto mls) { p2g_block<decltype(mls)::value>(p, grid, tp, b); });
   grid.gather_buffers_to_grid(tp.serial);
 }
 
 void grid_to_particles(ParticleSet& p, SparseGrid& grid, const TransferParams& tp) {
   grid.scatter_grid_to_buffers(tp.serial);
-  parallel_for(
-      grid.num_particle_blocks(), 1,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          if (tp.mls)
-            g2p_block<true>(p, grid, tp, b);
-          else
-            g2p_block<false>(p, grid, tp, b);
-          if (tp.others) tp.others(b, grid.pblock_buf[b].data());
-        }
-      },
-      tp.serial);
+  each_particle_block(
+      grid, tp, [&](std::size_t b, auto mls) { g2p_block<decltype(mls)::value>(p, grid, tp, b); });
 }
 
 }  // namespace shellmpm

@@ -1,11 +1,13 @@
 #include "sim/shell/kirchhoff_love.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <utility>
 
 #include "sim/core/check.h"
+#include "sim/core/counting_sort.h"
 #include "sim/core/parallel.h"
 #include "sim/shell/denting.h"
 #include "sim/shell/kl_kinematics.h"
@@ -24,12 +26,32 @@ using kl::layer_psi;
 using kl::mul2;
 using kl::PointKinematics;
 
+namespace {
+/// B_ba = gbar^b . e_a of the rest layer at xi3 (rest kinematics k) in the orthonormal rest
+/// frame e_1 = gbar_1/|gbar_1|, e_2 = a3 x e_1 (row-major into out[4]).
+template <class T>
+void rest_layer_B(const PointKinematics<double>& k, double xi3, std::size_t q, T* out) {
+  using V3d = Eigen::Matrix<double, 3, 1>;
+  const V3d g1 = k.a1 + xi3 * k.v1, g2 = k.a2 + xi3 * k.v2;
+  const V3d e1 = g1.normalized();
+  const V3d e2 = k.a3.cross(e1);
+  Eigen::Matrix2d G;
+  G << g1.dot(g1), g1.dot(g2), g1.dot(g2), g2.dot(g2);
+  SHELLMPM_CHECK(G.determinant() > 0, "degenerate rest layer at quadrature point " << q);
+  const Eigen::Matrix2d Gi = G.inverse();
+  const V3d d1 = Gi(0, 0) * g1 + Gi(0, 1) * g2, d2 = Gi(1, 0) * g1 + Gi(1, 1) * g2;
+  out[0] = T(d1.dot(e1));
+  out[1] = T(d1.dot(e2));
+  out[2] = T(d2.dot(e1));
+  out[3] = T(d2.dot(e2));
+}
+}  // namespace
+
 template <class T>
 KirchhoffLoveShellT<T>::KirchhoffLoveShellT(std::vector<BasisPoint> points,
                                             std::vector<double> inplane_weights,
                                             const std::vector<Eigen::Matrix<double, 3, 1>>& rest,
                                             const ShellMaterialDesc& mat, int thickness_points) {
-  using V3d = Eigen::Matrix<double, 3, 1>;
   SHELLMPM_CHECK(points.size() == inplane_weights.size(),
                  "points " << points.size() << " weights " << inplane_weights.size());
   SHELLMPM_CHECK(mat.youngs_modulus > 0 && mat.poisson_ratio > -1 && mat.poisson_ratio < 0.5 &&
@@ -56,7 +78,28 @@ KirchhoffLoveShellT<T>::KirchhoffLoveShellT(std::vector<BasisPoint> points,
     layer_xi3_.push_back(T(0.5 * t * gl.points[k]));
     layer_w_.push_back(T(0.5 * t * gl.weights[k]));
   }
+  size_entries(points);
+  rest_area_ = 0.0;
+  for (std::size_t q = 0; q < points.size(); ++q) {
+    const PointKinematics<double> k = load_point(q, points[q], rest);
+    const double jac = k.a1.cross(k.a2).norm();
+    SHELLMPM_CHECK(jac > 0 && std::isfinite(jac),
+                   "degenerate rest tangents at quadrature point " << q);
+    area_[q] = T(inplane_weights[q] * jac);
+    rest_area_ += inplane_weights[q] * jac;
+    for (int l = 0; l < num_layers_; ++l)
+      rest_layer_B(k, 0.5 * t * gl.points[l], q, &B_[4 * (q * num_layers_ + l)]);
+    rest_layer_B(k, 0.0, q, &B0_[4 * q]);
+  }
+  if (has_plasticity()) {
+    fp_inv_.resize(4 * points.size() * num_layers_);
+    reset_plastic_state();
+  }
+  build_gather_map();
+}
 
+template <class T>
+void KirchhoffLoveShellT<T>::size_entries(const std::vector<BasisPoint>& points) {
   const std::size_t nq = points.size();
   begin_.assign(nq + 1, 0);
   for (std::size_t q = 0; q < nq; ++q) {
@@ -75,76 +118,49 @@ KirchhoffLoveShellT<T>::KirchhoffLoveShellT(std::vector<BasisPoint> points,
   area_.resize(nq);
   B_.resize(4 * nq * num_layers_);
   B0_.resize(4 * nq);
-  rest_area_ = 0.0;
+}
 
-  for (std::size_t q = 0; q < nq; ++q) {
-    const BasisPoint& p = points[q];
-    V3d a1 = V3d::Zero(), a2 = V3d::Zero(), a11 = V3d::Zero(), a12 = V3d::Zero(), a22 = V3d::Zero();
-    for (std::size_t i = 0; i < p.ctrl.size(); ++i) {
-      const std::size_t e = begin_[q] + i;
-      const int j = p.ctrl[i];
-      SHELLMPM_CHECK(j >= 0 && std::size_t(j) < num_ctrl_, "control point "
-                                                               << j << " of quadrature point " << q
-                                                               << " out of range " << num_ctrl_);
-      ctrl_[e] = j;
-      entry_q_[e] = int(q);
-      value_[e] = T(p.N[i]);
-      coef_[5 * e + 0] = T(p.N1[i]);
-      coef_[5 * e + 1] = T(p.N2[i]);
-      coef_[5 * e + 2] = T(p.N11[i]);
-      coef_[5 * e + 3] = T(p.N12[i]);
-      coef_[5 * e + 4] = T(p.N22[i]);
-      const V3d& xj = rest[j];
-      a1 += p.N1[i] * xj;
-      a2 += p.N2[i] * xj;
-      a11 += p.N11[i] * xj;
-      a12 += p.N12[i] * xj;
-      a22 += p.N22[i] * xj;
-    }
-    PointKinematics<double> k;
-    k.a1 = a1;
-    k.a2 = a2;
-    k.a11 = a11;
-    k.a12 = a12;
-    k.a22 = a22;
-    const double jac = a1.cross(a2).norm();
-    SHELLMPM_CHECK(jac > 0 && std::isfinite(jac),
-                   "degenerate rest tangents at quadrature point " << q);
-    compute_kinematics(k);
-    area_[q] = T(inplane_weights[q] * jac);
-    rest_area_ += inplane_weights[q] * jac;
-    // B_ba = gbar^b . e_a in the orthonormal rest frame e_1 = gbar_1/|gbar_1|, e_2 = a3 x e_1.
-    auto rest_B = [&](double xi3, T* out) {
-      const V3d g1 = k.a1 + xi3 * k.v1, g2 = k.a2 + xi3 * k.v2;
-      const V3d e1 = g1.normalized();
-      const V3d e2 = k.a3.cross(e1);
-      Eigen::Matrix2d G;
-      G << g1.dot(g1), g1.dot(g2), g1.dot(g2), g2.dot(g2);
-      SHELLMPM_CHECK(G.determinant() > 0, "degenerate rest layer at quadrature point " << q);
-      const Eigen::Matrix2d Gi = G.inverse();
-      const V3d d1 = Gi(0, 0) * g1 + Gi(0, 1) * g2, d2 = Gi(1, 0) * g1 + Gi(1, 1) * g2;
-      out[0] = T(d1.dot(e1));
-      out[1] = T(d1.dot(e2));
-      out[2] = T(d2.dot(e1));
-      out[3] = T(d2.dot(e2));
-    };
-    for (int l = 0; l < num_layers_; ++l)
-      rest_B(0.5 * t * gl.points[l], &B_[4 * (q * num_layers_ + l)]);
-    rest_B(0.0, &B0_[4 * q]);
+template <class T>
+PointKinematics<double> KirchhoffLoveShellT<T>::load_point(
+    std::size_t q, const BasisPoint& p, const std::vector<Eigen::Matrix<double, 3, 1>>& rest) {
+  using V3d = Eigen::Matrix<double, 3, 1>;
+  V3d a1 = V3d::Zero(), a2 = V3d::Zero(), a11 = V3d::Zero(), a12 = V3d::Zero(), a22 = V3d::Zero();
+  for (std::size_t i = 0; i < p.ctrl.size(); ++i) {
+    const std::size_t e = begin_[q] + i;
+    const int j = p.ctrl[i];
+    SHELLMPM_CHECK(j >= 0 && std::size_t(j) < num_ctrl_, "control point "
+                                                             << j << " of quadrature point " << q
+                                                             << " out of range " << num_ctrl_);
+    ctrl_[e] = j;
+    entry_q_[e] = int(q);
+    value_[e] = T(p.N[i]);
+    coef_[5 * e + 0] = T(p.N1[i]);
+    coef_[5 * e + 1] = T(p.N2[i]);
+    coef_[5 * e + 2] = T(p.N11[i]);
+    coef_[5 * e + 3] = T(p.N12[i]);
+    coef_[5 * e + 4] = T(p.N22[i]);
+    const V3d& xj = rest[j];
+    a1 += p.N1[i] * xj;
+    a2 += p.N2[i] * xj;
+    a11 += p.N11[i] * xj;
+    a12 += p.N12[i] * xj;
+    a22 += p.N22[i] * xj;
   }
+  PointKinematics<double> k;
+  k.a1 = a1;
+  k.a2 = a2;
+  k.a11 = a11;
+  k.a12 = a12;
+  k.a22 = a22;
+  compute_kinematics(k);
+  return k;
+}
 
-  if (has_plasticity()) {
-    fp_inv_.resize(4 * nq * num_layers_);
-    reset_plastic_state();
-  }
-
-  // Gather map: counting sort of entries by control point (ascending entry order).
-  gather_begin_.assign(num_ctrl_ + 1, 0);
-  for (std::size_t e = 0; e < ne; ++e) ++gather_begin_[ctrl_[e] + 1];
-  for (std::size_t j = 0; j < num_ctrl_; ++j) gather_begin_[j + 1] += gather_begin_[j];
-  gather_.resize(ne);
-  std::vector<std::size_t> fill(gather_begin_.begin(), gather_begin_.end() - 1);
-  for (std::size_t e = 0; e < ne; ++e) gather_[fill[ctrl_[e]]++] = e;
+template <class T>
+void KirchhoffLoveShellT<T>::build_gather_map() {
+  // Entries by control point (ascending entry order).
+  counting_sort(
+      ctrl_.size(), num_ctrl_, [&](std::size_t e) { return ctrl_[e]; }, gather_begin_, gather_);
 }
 
 template <class T>
@@ -249,22 +265,19 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
   const std::size_t nq = area_.size();
   // Per-point adjoints of (a_1, a_2, a_11, a_12, a_22); every entry is written below.
   std::unique_ptr<T[]> grad(forces ? new T[15 * nq] : nullptr);
-  const std::size_t chunks = (nq + kPointGrain - 1) / kPointGrain;
-  std::vector<double> part_total(chunks, 0.0), part_mem(chunks, 0.0);
-  parallel_for(
-      nq, kPointGrain,
-      [&](std::size_t b, std::size_t e) {
-        double et = 0.0, em = 0.0;
-        for (std::size_t q = b; q < e; ++q)
-          eval_point(q, x, forces ? &grad[15 * q] : nullptr, et, em);
-        part_total[b / kPointGrain] = et;
-        part_mem[b / kPointGrain] = em;
-      },
-      serial);
+  // Per chunk: total and membrane energy.
+  const std::vector<std::array<double, 2>> parts =
+      chunk_parts(nq, kPointGrain, serial, std::array<double, 2>{0.0, 0.0},
+                  [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
+                    double et = 0.0, em = 0.0;
+                    for (std::size_t q = b; q < e; ++q)
+                      eval_point(q, x, forces ? &grad[15 * q] : nullptr, et, em);
+                    part = {et, em};
+                  });
   double et = 0.0, em = 0.0;
-  for (std::size_t c = 0; c < chunks; ++c) {
-    et += part_total[c];
-    em += part_mem[c];
+  for (const std::array<double, 2>& part : parts) {
+    et += part[0];
+    em += part[1];
   }
   if (forces) {
     // Gather: dE/dx_j = sum over entries (q, j) of N1 Ga1 + N2 Ga2 + N11 G11 + N12 G12 + N22 G22.

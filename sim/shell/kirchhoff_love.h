@@ -84,6 +84,11 @@ namespace shellmpm {
 
 /// Rest data and plastic state for all quadrature points of one shell.
 /// T is the evaluation scalar (float or double); rest data is computed in double.
+namespace kl {
+template <class T>
+struct PointKinematics;  // sim/shell/kl_kinematics.h
+}  // namespace kl
+
 template <class T>
 class KirchhoffLoveShellT {
  public:
@@ -150,6 +155,14 @@ class KirchhoffLoveShellT {
   double rest_area() const { return rest_area_; }
 
  private:
+  // Construction steps.
+  /// begin_ from the points' entry counts; the per-entry and per-point arrays sized.
+  void size_entries(const std::vector<BasisPoint>& points);
+  /// Point q's entries (control points, N and its derivatives) and its rest kinematics.
+  kl::PointKinematics<double> load_point(std::size_t q, const BasisPoint& p,
+                                         const std::vector<Eigen::Matrix<double, 3, 1>>& rest);
+  /// gather_begin_, gather_ from ctrl_.
+  void build_gather_map();
   // Per quadrature point: adjoints of (a_1, a_2, a_11, a_12, a_22) in `grad`
   // (15 values); returns energy and membrane energy.
   void eval_point(std::size_t q, const Vec3T* x, T* grad, double& e_total,

@@ -58,12 +58,9 @@ template <class T>
 T KirchhoffLoveShellT<T>::max_strain(const Vec3T* x, bool serial) const {
   const std::size_t nq = area_.size();
   if (nq == 0) return T(0);
-  const std::size_t chunks = (nq + kPointGrain - 1) / kPointGrain;
-  std::vector<T> part(chunks, T(0));
   const bool plastic = !fp_inv_.empty();
-  parallel_for(
-      nq, kPointGrain,
-      [&](std::size_t b, std::size_t e) {
+  const std::vector<T> part =
+      chunk_parts(nq, kPointGrain, serial, T(0), [&](std::size_t b, std::size_t e, T& out) {
         T m = 0;
         for (std::size_t q = b; q < e; ++q) {
           PointKinematics<T> k;
@@ -83,9 +80,8 @@ T KirchhoffLoveShellT<T>::max_strain(const Vec3T* x, bool serial) const {
             m = std::max(m, std::max(std::abs(l1), std::abs(l2)));
           }
         }
-        part[b / kPointGrain] = m;
-      },
-      serial);
+        out = m;
+      });
   return *std::max_element(part.begin(), part.end());
 }
 

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "sim/core/check.h"
+#include "sim/core/counting_sort.h"
 #include "sim/shell/box_spline.h"
 
 namespace shellmpm {
@@ -194,99 +195,116 @@ void target_fans(const LocalMesh& m, Scratch& w) {
   for (int k = 0; k < 3; ++k) local_fan(m, m.faces[m.target][k], w, w.ring[k], w.boundary[k]);
 }
 
-/// One level of local Loop subdivision; keeps the child of the target face that contains
-/// (s, t) and the child faces around its corners, and maps (s, t) to the child.
-/// Needs target_fans(m, w) computed.
-void subdivide_local(LocalMesh& m, Scratch& w, double& s, double& t, double& scale) {
-  const std::array<int, 3> T = m.faces[m.target];
-  const int nold = m.rows();
+int edge_index(const Scratch& w, int a, int b) {
+  if (a > b) std::swap(a, b);
+  for (const auto& e : w.edges)
+    if (e[0] == a && e[1] == b) return e[2];
+  return -1;
+}
+
+/// Ends the mask being written and returns the new vertex's index.
+int close_mask(Scratch& w) {
+  w.mask_begin.push_back(static_cast<int>(w.mask.size()));
+  return static_cast<int>(w.mask_begin.size()) - 2;
+}
+
+/// Loop's vertex mask of corner c with fan `ring` (interior, boundary or sharp corner).
+void vertex_mask(int c, const std::vector<int>& ring, bool boundary, Scratch& w) {
+  const int n = static_cast<int>(ring.size());
+  if (!boundary) {
+    const double b = loop_beta(n);
+    w.mask.emplace_back(c, 1.0 - n * b);
+    for (int x : ring) w.mask.emplace_back(x, b);
+  } else if (n == 2) {  // one face: sharp corner
+    w.mask.emplace_back(c, 1.0);
+  } else {
+    w.mask.emplace_back(c, 0.75);
+    w.mask.emplace_back(ring.front(), 0.125);
+    w.mask.emplace_back(ring.back(), 0.125);
+  }
+}
+
+/// Loop's edge mask of edge (c, x): 3/8, 3/8, 1/8, 1/8 inside, 1/2, 1/2 on the boundary.
+void edge_mask(const LocalMesh& m, int c, int x, Scratch& w) {
+  w.opp.clear();
+  for (const auto& f : m.faces)
+    for (int q = 0; q < 3; ++q)
+      if (f[q] == c && (f[(q + 1) % 3] == x || f[(q + 2) % 3] == x))
+        w.opp.push_back(f[(q + 1) % 3] == x ? f[(q + 2) % 3] : f[(q + 1) % 3]);
+  SHELLMPM_CHECK(w.opp.size() == 1 || w.opp.size() == 2,
+                 << "edge with " << w.opp.size() << " faces");
+  if (w.opp.size() == 1) {
+    w.mask.emplace_back(c, 0.5);
+    w.mask.emplace_back(x, 0.5);
+  } else {
+    w.mask.emplace_back(c, 0.375);
+    w.mask.emplace_back(x, 0.375);
+    w.mask.emplace_back(w.opp[0], 0.125);
+    w.mask.emplace_back(w.opp[1], 0.125);
+  }
+}
+
+/// Masks of the new vertices around target face T: each corner's vertex point, then the
+/// edge points of its fan (each edge once). Writes w.mask, w.mask_begin, w.vp, w.edges.
+void target_masks(const LocalMesh& m, const std::array<int, 3>& T, Scratch& w) {
   w.mask.clear();
   w.mask_begin.assign(1, 0);
-  w.vp.assign(nold, -1);
+  w.vp.assign(m.rows(), -1);
   w.edges.clear();
-  auto edge_index = [&](int a, int b) {
-    if (a > b) std::swap(a, b);
-    for (const auto& e : w.edges)
-      if (e[0] == a && e[1] == b) return e[2];
-    return -1;
-  };
-  auto close_mask = [&]() {
-    w.mask_begin.push_back(static_cast<int>(w.mask.size()));
-    return static_cast<int>(w.mask_begin.size()) - 2;
-  };
   for (int k = 0; k < 3; ++k) {
     const int c = T[k];
-    const std::vector<int>& ring = w.ring[k];
-    const int n = static_cast<int>(ring.size());
-    if (!w.boundary[k]) {
-      const double b = loop_beta(n);
-      w.mask.emplace_back(c, 1.0 - n * b);
-      for (int x : ring) w.mask.emplace_back(x, b);
-    } else if (n == 2) {  // one face: sharp corner
-      w.mask.emplace_back(c, 1.0);
-    } else {
-      w.mask.emplace_back(c, 0.75);
-      w.mask.emplace_back(ring.front(), 0.125);
-      w.mask.emplace_back(ring.back(), 0.125);
-    }
-    w.vp[c] = close_mask();
-    for (int x : ring) {
-      if (edge_index(c, x) >= 0) continue;
-      w.opp.clear();
-      for (const auto& f : m.faces)
-        for (int q = 0; q < 3; ++q)
-          if (f[q] == c && (f[(q + 1) % 3] == x || f[(q + 2) % 3] == x))
-            w.opp.push_back(f[(q + 1) % 3] == x ? f[(q + 2) % 3] : f[(q + 1) % 3]);
-      SHELLMPM_CHECK(w.opp.size() == 1 || w.opp.size() == 2,
-                     << "edge with " << w.opp.size() << " faces");
-      if (w.opp.size() == 1) {
-        w.mask.emplace_back(c, 0.5);
-        w.mask.emplace_back(x, 0.5);
-      } else {
-        w.mask.emplace_back(c, 0.375);
-        w.mask.emplace_back(x, 0.375);
-        w.mask.emplace_back(w.opp[0], 0.125);
-        w.mask.emplace_back(w.opp[1], 0.125);
-      }
-      w.edges.push_back({std::min(c, x), std::max(c, x), close_mask()});
+    vertex_mask(c, w.ring[k], w.boundary[k], w);
+    w.vp[c] = close_mask(w);
+    for (int x : w.ring[k]) {
+      if (edge_index(w, c, x) >= 0) continue;
+      edge_mask(m, c, x, w);
+      w.edges.push_back({std::min(c, x), std::max(c, x), close_mask(w)});
     }
   }
-  // Children of a parent face (-1 where a vertex was not computed), counter-clockwise,
-  // ordered so that child parameters are +-2 xi + const (see the switch below).
-  auto children = [&](const std::array<int, 3>& f, std::array<int, 3> ch[4]) {
-    const int va = w.vp[f[0]], vb = w.vp[f[1]], vc = w.vp[f[2]];
-    const int eab = edge_index(f[0], f[1]), ebc = edge_index(f[1], f[2]),
-              eca = edge_index(f[2], f[0]);
-    ch[0] = {va, eab, eca};
-    ch[1] = {eab, vb, ebc};
-    ch[2] = {eca, ebc, vc};
-    ch[3] = {ebc, eca, eab};
-  };
-  std::array<int, 3> tc[4];
-  children(T, tc);
-  int which;
+}
+
+/// Children of a parent face (-1 where a vertex was not computed), counter-clockwise,
+/// ordered so that child parameters are +-2 xi + const (see descend()).
+void face_children(const Scratch& w, const std::array<int, 3>& f, std::array<int, 3> ch[4]) {
+  const int va = w.vp[f[0]], vb = w.vp[f[1]], vc = w.vp[f[2]];
+  const int eab = edge_index(w, f[0], f[1]), ebc = edge_index(w, f[1], f[2]),
+            eca = edge_index(w, f[2], f[0]);
+  ch[0] = {va, eab, eca};
+  ch[1] = {eab, vb, ebc};
+  ch[2] = {eca, ebc, vc};
+  ch[3] = {ebc, eca, eab};
+}
+
+/// The child (0-3, see face_children()) that contains (s, t); maps (s, t) to its
+/// parameters and multiplies scale by d(child xi) / d(parent xi).
+int descend(double& s, double& t, double& scale) {
   if (s >= 0.5) {
-    which = 1;
     s = 2 * s - 1;
     t = 2 * t;
     scale *= 2;
-  } else if (t >= 0.5) {
-    which = 2;
+    return 1;
+  }
+  if (t >= 0.5) {
     s = 2 * s;
     t = 2 * t - 1;
     scale *= 2;
-  } else if (s + t <= 0.5) {
-    which = 0;
+    return 2;
+  }
+  if (s + t <= 0.5) {
     s = 2 * s;
     t = 2 * t;
     scale *= 2;
-  } else {
-    which = 3;
-    s = 1 - 2 * s;
-    t = 1 - 2 * t;
-    scale *= -2;
+    return 0;
   }
-  const std::array<int, 3> target = tc[which];
+  s = 1 - 2 * s;
+  t = 1 - 2 * t;
+  scale *= -2;
+  return 3;
+}
+
+/// The child faces that touch `target` into w.next.faces (renumbered; w.remap, w.used
+/// map old mask index <-> new vertex). Returns the number of new vertices.
+int collect_children(const LocalMesh& m, const std::array<int, 3>& target, Scratch& w) {
   LocalMesh& out = w.next;
   out.faces.clear();
   const int nmasks = static_cast<int>(w.mask_begin.size()) - 1;
@@ -295,7 +313,7 @@ void subdivide_local(LocalMesh& m, Scratch& w, double& s, double& t, double& sca
   int nnew = 0;
   for (const auto& f : m.faces) {
     std::array<int, 3> ch[4];
-    children(f, ch);
+    face_children(w, f, ch);
     for (const auto& cf : ch) {
       if (cf[0] < 0 || cf[1] < 0 || cf[2] < 0) continue;
       bool touches = false;
@@ -314,8 +332,14 @@ void subdivide_local(LocalMesh& m, Scratch& w, double& s, double& t, double& sca
       out.faces.push_back(nf);
     }
   }
-  // Masks sum to one, so sum_k m_ik W_k - ref' = sum_k m_ik D_k - sum_k m_0k D_k with
-  // ref' = ref + sum_k m_0k D_k the row of new vertex 0.
+  return nnew;
+}
+
+/// Rows of the nnew kept vertices into w.next.ref / w.next.D. Masks sum to one, so
+/// sum_k m_ik W_k - ref' = sum_k m_ik D_k - sum_k m_0k D_k with ref' = ref + sum_k m_0k D_k
+/// the row of new vertex 0.
+void apply_masks(const LocalMesh& m, int nnew, Scratch& w) {
+  LocalMesh& out = w.next;
   auto mask_of = [&](int i) {
     return std::make_pair(w.mask.begin() + w.mask_begin[w.used[i]],
                           w.mask.begin() + w.mask_begin[w.used[i] + 1]);
@@ -329,7 +353,20 @@ void subdivide_local(LocalMesh& m, Scratch& w, double& s, double& t, double& sca
       out.D.row(i) += it->second * m.D.row(it->first);
     out.D.row(i) -= shift;
   }
-  std::swap(m, out);
+}
+
+/// One level of local Loop subdivision; keeps the child of the target face that contains
+/// (s, t) and the child faces around its corners, and maps (s, t) to the child.
+/// Needs target_fans(m, w) computed.
+void subdivide_local(LocalMesh& m, Scratch& w, double& s, double& t, double& scale) {
+  const std::array<int, 3> T = m.faces[m.target];
+  target_masks(m, T, w);
+  std::array<int, 3> tc[4];
+  face_children(w, T, tc);
+  const std::array<int, 3> target = tc[descend(s, t, scale)];
+  const int nnew = collect_children(m, target, w);
+  apply_masks(m, nnew, w);
+  std::swap(m, w.next);
 }
 
 std::string face_str(int f, const Eigen::Vector3i& t) {
@@ -338,13 +375,132 @@ std::string face_str(int f, const Eigen::Vector3i& t) {
   return os.str();
 }
 
+/// Throws unless (xi1, xi2) lies in the parameter triangle of `face` (tolerance 1e-12),
+/// then clamps it into the triangle.
+void check_and_clamp(int face, double& xi1, double& xi2) {
+  const double tol = 1e-12;
+  if (!(xi1 >= -tol && xi2 >= -tol && xi1 + xi2 <= 1 + tol)) {
+    std::ostringstream os;
+    os << "LoopBasis::evaluate: point (" << xi1 << ", " << xi2 << ") outside face " << face;
+    throw std::invalid_argument(os.str());
+  }
+  xi1 = std::max(xi1, 0.0);
+  xi2 = std::max(xi2, 0.0);
+  if (xi1 + xi2 > 1) {
+    const double sum = xi1 + xi2;
+    xi1 /= sum;
+    xi2 /= sum;
+  }
+}
+
+/// Basis of a regular patch with lattice P at (xi1, xi2): the box spline's 12 functions
+/// gathered onto the real vertices (phantoms spread with their weights).
+void regular_basis(const LatticePoint P[12], double xi1, double xi2, BasisPoint& o) {
+  double B[6][12];
+  box_spline(xi1, xi2, B);
+  o.ctrl.clear();
+  std::vector<double>* q[6] = {&o.N, &o.N1, &o.N2, &o.N11, &o.N12, &o.N22};
+  for (auto* v : q) v->clear();
+  for (int k = 0; k < 12; ++k)
+    for (int m = 0; m < P[k].n; ++m) {
+      const int id = P[k].idx[m];
+      std::size_t pos = 0;
+      while (pos < o.ctrl.size() && o.ctrl[pos] != id) ++pos;
+      if (pos == o.ctrl.size()) {
+        o.ctrl.push_back(id);
+        for (auto* v : q) v->push_back(0.0);
+      }
+      for (int d = 0; d < 6; ++d) (*q[d])[pos] += P[k].w[m] * B[d][k];
+    }
+}
+
+/// Moves a point closer than 1e-9 to an irregular corner of fans gf that distance towards
+/// the face centroid (see loop_basis.h). Returns that corner (0-2), or -1 if none.
+int nudge_off_irregular_corner(const FanView gf[3], double& xi1, double& xi2) {
+  const double nudge = 1e-9;
+  const double corner_xi[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  int exact_corner = -1;
+  for (int k = 0; k < 3; ++k) {
+    const bool regular_vertex = gf[k].boundary ? gf[k].size == 4 : gf[k].size == 6;
+    if (regular_vertex) continue;
+    const double dx = xi1 - corner_xi[k][0], dy = xi2 - corner_xi[k][1];
+    if (std::sqrt(dx * dx + dy * dy) < nudge) {
+      exact_corner = k;
+      const double cx = 1.0 / 3 - corner_xi[k][0], cy = 1.0 / 3 - corner_xi[k][1];
+      const double len = std::sqrt(cx * cx + cy * cy);
+      xi1 = corner_xi[k][0] + nudge * cx / len;
+      xi2 = corner_xi[k][1] + nudge * cy / len;
+    }
+  }
+  return exact_corner;
+}
+
+/// Local index of global vertex g in ctrl, appending it if new.
+int local_index(std::vector<int>& ctrl, int g) {
+  for (std::size_t i = 0; i < ctrl.size(); ++i)
+    if (ctrl[i] == g) return static_cast<int>(i);
+  ctrl.push_back(g);
+  return static_cast<int>(ctrl.size()) - 1;
+}
+
+/// The local mesh of `faces` (global ids, repeats skipped) with `face` as target;
+/// ctrl receives local -> global vertex. Rows start as the identity, as differences from
+/// local vertex 0.
+LocalMesh local_patch(const std::vector<Eigen::Vector3i>& tris, const std::vector<int>& faces,
+                      int face, std::vector<int>& ctrl) {
+  LocalMesh m;
+  for (const int f : faces) {
+    bool seen = false;
+    std::array<int, 3> lf = {local_index(ctrl, tris[f][0]), local_index(ctrl, tris[f][1]),
+                             local_index(ctrl, tris[f][2])};
+    for (const auto& g : m.faces) seen |= g == lf;
+    if (seen) continue;
+    if (f == face) m.target = static_cast<int>(m.faces.size());
+    m.faces.push_back(lf);
+  }
+  const int nctrl = static_cast<int>(ctrl.size());
+  m.ref = Eigen::RowVectorXd::Zero(nctrl);
+  m.ref[0] = 1;
+  m.D.setIdentity(nctrl, nctrl);
+  m.D.col(0).array() -= 1.0;
+  return m;
+}
+
+/// True when the target face of m (fans in w) is a regular patch; writes its lattice P.
+bool local_regular_lattice(const LocalMesh& m, const Scratch& w, LatticePoint P[12]) {
+  const std::array<int, 3>& lt = m.faces[m.target];
+  const int lc[3] = {lt[0], lt[1], lt[2]};
+  FanView lf[3];
+  for (int k = 0; k < 3; ++k)
+    lf[k] = FanView{w.ring[k].data(), static_cast<int>(w.ring[k].size()), w.boundary[k]};
+  return regular_lattice(lc, lf, P);
+}
+
+/// Value and 5 derivatives (columns) of the initial control points' basis (rows) at
+/// (s, t) of m's regular target patch P; derivatives scaled back to the original face.
+Eigen::Matrix<double, Eigen::Dynamic, 6> local_basis(const LocalMesh& m, const LatticePoint P[12],
+                                                     double s, double t, double scale) {
+  double B[6][12];
+  box_spline(s, t, B);
+  const double fac[6] = {1, scale, scale, scale * scale, scale * scale, scale * scale};
+  Eigen::Matrix<double, Eigen::Dynamic, 6> local =
+      Eigen::Matrix<double, Eigen::Dynamic, 6>::Zero(m.rows(), 6);
+  for (int k = 0; k < 12; ++k)
+    for (int q = 0; q < P[k].n; ++q)
+      for (int d = 0; d < 6; ++d) local(P[k].idx[q], d) += P[k].w[q] * B[d][k] * fac[d];
+  // sum_i local(i, d) is 1 for the value and exactly 0 for the derivatives (partition
+  // of unity), so the reference row enters the value only.
+  Eigen::Matrix<double, Eigen::Dynamic, 6> global = m.D.transpose() * local;
+  global.col(0) += m.ref.transpose();
+  return global;
+}
+
 }  // namespace
 
 LoopBasis::LoopBasis(int num_vertices, const std::vector<Eigen::Vector3i>& triangles)
     : num_vertices_(num_vertices), tris_(triangles) {
   if (num_vertices < 0) throw std::invalid_argument("LoopBasis: negative vertex count");
   const int nf = static_cast<int>(tris_.size());
-  std::vector<int> count(num_vertices + 1, 0);
   for (int f = 0; f < nf; ++f) {
     const Eigen::Vector3i& t = tris_[f];
     for (int k = 0; k < 3; ++k)
@@ -354,13 +510,13 @@ LoopBasis::LoopBasis(int num_vertices, const std::vector<Eigen::Vector3i>& trian
                                     std::to_string(num_vertices) + ")");
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
       throw std::invalid_argument("LoopBasis: " + face_str(f, t) + " repeats a vertex");
-    for (int k = 0; k < 3; ++k) ++count[t[k] + 1];
   }
-  face_offset_.assign(num_vertices + 1, 0);
-  for (int v = 0; v < num_vertices; ++v) face_offset_[v + 1] = face_offset_[v] + count[v + 1];
-  std::vector<int> raw(face_offset_.back()), fill(face_offset_.begin(), face_offset_.end() - 1);
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) raw[fill[tris_[f][k]]++] = f;
+  // The faces around each vertex in face order: corner entries 3 f + k sorted by vertex.
+  std::vector<int> raw;
+  counting_sort(
+      3 * tris_.size(), static_cast<std::size_t>(num_vertices),
+      [&](std::size_t e) { return tris_[e / 3][static_cast<int>(e % 3)]; }, face_offset_, raw);
+  for (int& e : raw) e /= 3;
   vface_.resize(raw.size());
   ring_offset_.assign(num_vertices + 1, 0);
   boundary_.assign(num_vertices, 0);
@@ -405,114 +561,44 @@ int LoopBasis::evaluate_impl(int face, double xi1, double xi2, BasisPoint* out) 
   if (face < 0 || face >= num_faces())
     throw std::invalid_argument("LoopBasis::evaluate: face " + std::to_string(face) +
                                 " out of range [0, " + std::to_string(num_faces()) + ")");
-  const double tol = 1e-12;
-  if (!(xi1 >= -tol && xi2 >= -tol && xi1 + xi2 <= 1 + tol)) {
-    std::ostringstream os;
-    os << "LoopBasis::evaluate: point (" << xi1 << ", " << xi2 << ") outside face " << face;
-    throw std::invalid_argument(os.str());
-  }
-  xi1 = std::max(xi1, 0.0);
-  xi2 = std::max(xi2, 0.0);
-  if (xi1 + xi2 > 1) {
-    const double sum = xi1 + xi2;
-    xi1 /= sum;
-    xi2 /= sum;
-  }
+  check_and_clamp(face, xi1, xi2);
   const Eigen::Vector3i& T = tris_[face];
   const int c[3] = {T[0], T[1], T[2]};
-  LatticePoint P[12];
-  double B[6][12];
   auto global_fan = [&](int v) {
     return FanView{ring_.data() + ring_offset_[v], ring_offset_[v + 1] - ring_offset_[v],
                    boundary_[v] != 0};
   };
   const FanView gf[3] = {global_fan(c[0]), global_fan(c[1]), global_fan(c[2])};
+  LatticePoint P[12];
   if (regular_lattice(c, gf, P)) {
-    if (!out) return 0;
-    box_spline(xi1, xi2, B);
-    BasisPoint& o = *out;
-    o.ctrl.clear();
-    std::vector<double>* q[6] = {&o.N, &o.N1, &o.N2, &o.N11, &o.N12, &o.N22};
-    for (auto* v : q) v->clear();
-    for (int k = 0; k < 12; ++k)
-      for (int m = 0; m < P[k].n; ++m) {
-        const int id = P[k].idx[m];
-        std::size_t pos = 0;
-        while (pos < o.ctrl.size() && o.ctrl[pos] != id) ++pos;
-        if (pos == o.ctrl.size()) {
-          o.ctrl.push_back(id);
-          for (auto* v : q) v->push_back(0.0);
-        }
-        for (int d = 0; d < 6; ++d) (*q[d])[pos] += P[k].w[m] * B[d][k];
-      }
+    if (out) regular_basis(P, xi1, xi2, *out);
     return 0;
   }
-
   // Irregular patch: nudge the point off an irregular corner (see header), then refine.
-  const double nudge = 1e-9;
-  const double corner_xi[3][2] = {{0, 0}, {1, 0}, {0, 1}};
-  int exact_corner = -1;
-  for (int k = 0; k < 3; ++k) {
-    const bool regular_vertex = gf[k].boundary ? gf[k].size == 4 : gf[k].size == 6;
-    if (regular_vertex) continue;
-    const double dx = xi1 - corner_xi[k][0], dy = xi2 - corner_xi[k][1];
-    if (std::sqrt(dx * dx + dy * dy) < nudge) {
-      exact_corner = k;
-      const double cx = 1.0 / 3 - corner_xi[k][0], cy = 1.0 / 3 - corner_xi[k][1];
-      const double len = std::sqrt(cx * cx + cy * cy);
-      xi1 = corner_xi[k][0] + nudge * cx / len;
-      xi2 = corner_xi[k][1] + nudge * cy / len;
-    }
-  }
-  LocalMesh m;
-  std::vector<int> ctrl;  // local index -> global vertex
-  auto local_of = [&](int g) {
-    for (std::size_t i = 0; i < ctrl.size(); ++i)
-      if (ctrl[i] == g) return static_cast<int>(i);
-    ctrl.push_back(g);
-    return static_cast<int>(ctrl.size()) - 1;
-  };
+  const int exact_corner = nudge_off_irregular_corner(gf, xi1, xi2);
+  return evaluate_irregular(face, xi1, xi2, exact_corner, out);
+}
+
+int LoopBasis::evaluate_irregular(int face, double xi1, double xi2, int exact_corner,
+                                  BasisPoint* out) const {
+  const Eigen::Vector3i& c = tris_[face];
+  std::vector<int> around;  // the faces around the corners, in fan order
   for (int k = 0; k < 3; ++k)
-    for (int i = face_offset_[c[k]]; i < face_offset_[c[k] + 1]; ++i) {
-      const int f = vface_[i];
-      bool seen = false;
-      std::array<int, 3> lf = {local_of(tris_[f][0]), local_of(tris_[f][1]), local_of(tris_[f][2])};
-      for (const auto& g : m.faces) seen |= g == lf;
-      if (seen) continue;
-      if (f == face) m.target = static_cast<int>(m.faces.size());
-      m.faces.push_back(lf);
-    }
-  const int nctrl = static_cast<int>(ctrl.size());
-  m.ref = Eigen::RowVectorXd::Zero(nctrl);
-  m.ref[0] = 1;
-  m.D.setIdentity(nctrl, nctrl);
-  m.D.col(0).array() -= 1.0;
+    for (int i = face_offset_[c[k]]; i < face_offset_[c[k] + 1]; ++i) around.push_back(vface_[i]);
+  std::vector<int> ctrl;  // local index -> global vertex
+  LocalMesh m = local_patch(tris_, around, face, ctrl);
   double s = xi1, t = xi2, scale = 1.0;
   Scratch w;
   target_fans(m, w);
+  LatticePoint P[12];
   for (int level = 1;; ++level) {
     SHELLMPM_CHECK(level <= 80, << "local subdivision did not reach a regular patch (face " << face
                                 << ", xi " << xi1 << ", " << xi2 << ")");
     subdivide_local(m, w, s, t, scale);
     target_fans(m, w);
-    const std::array<int, 3>& lt = m.faces[m.target];
-    const int lc[3] = {lt[0], lt[1], lt[2]};
-    FanView lf[3];
-    for (int k = 0; k < 3; ++k)
-      lf[k] = FanView{w.ring[k].data(), static_cast<int>(w.ring[k].size()), w.boundary[k]};
-    if (!regular_lattice(lc, lf, P)) continue;
+    if (!local_regular_lattice(m, w, P)) continue;
     if (!out) return level;
-    box_spline(s, t, B);
-    const double fac[6] = {1, scale, scale, scale * scale, scale * scale, scale * scale};
-    Eigen::Matrix<double, Eigen::Dynamic, 6> local =
-        Eigen::Matrix<double, Eigen::Dynamic, 6>::Zero(m.rows(), 6);
-    for (int k = 0; k < 12; ++k)
-      for (int q = 0; q < P[k].n; ++q)
-        for (int d = 0; d < 6; ++d) local(P[k].idx[q], d) += P[k].w[q] * B[d][k] * fac[d];
-    // sum_i local(i, d) is 1 for the value and exactly 0 for the derivatives (partition
-    // of unity), so the reference row enters the value only.
-    Eigen::Matrix<double, Eigen::Dynamic, 6> global = m.D.transpose() * local;
-    global.col(0) += m.ref.transpose();
+    Eigen::Matrix<double, Eigen::Dynamic, 6> global = local_basis(m, P, s, t, scale);
     if (exact_corner >= 0) {
       // At an irregular vertex the value is its exact limit (see header); derivatives
       // are those of the nudged point.
@@ -521,7 +607,7 @@ int LoopBasis::evaluate_impl(int face, double xi1, double xi2, BasisPoint* out) 
       std::vector<double> lim_w;
       vertex_limit_weights(c[exact_corner], lim_ctrl, lim_w);
       for (std::size_t k = 0; k < lim_ctrl.size(); ++k)
-        global(local_of(lim_ctrl[k]), 0) += lim_w[k];
+        global(local_index(ctrl, lim_ctrl[k]), 0) += lim_w[k];
     }
     BasisPoint& o = *out;
     o.ctrl = ctrl;

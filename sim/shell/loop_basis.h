@@ -85,6 +85,9 @@ class LoopBasis {
 
  private:
   int evaluate_impl(int face, double xi1, double xi2, BasisPoint* out) const;
+  /// evaluate_impl() on a patch with an irregular corner: local subdivision (Cirak et al.
+  /// 2000, sec. 3) until the point lies in a regular patch; returns the depth.
+  int evaluate_irregular(int face, double xi1, double xi2, int exact_corner, BasisPoint* out) const;
   int num_vertices_ = 0;
   std::vector<Eigen::Vector3i> tris_;
   // Per-vertex fan, counter-clockwise: face i of vertex v is (v, ring[i], ring[i+1]),

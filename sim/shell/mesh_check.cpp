@@ -54,15 +54,15 @@ int find_root(std::vector<int>& parent, int a) {
   return a;
 }
 
-}  // namespace
-
-std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
-                                          const std::vector<Eigen::Vector3i>& tris) {
-  std::vector<MeshProblem> out;
+/// Per face: indices in range and distinct (else a DegenerateIndex problem, valid 0),
+/// corners not collinear (else a ZeroAreaFace problem).
+std::vector<char> check_faces(const std::vector<Vec3d>& vertices,
+                              const std::vector<Eigen::Vector3i>& tris,
+                              std::vector<MeshProblem>& degenerate,
+                              std::vector<MeshProblem>& zero_area) {
   const int nv = static_cast<int>(vertices.size());
   const int nf = static_cast<int>(tris.size());
   std::vector<char> valid(nf, 1);
-  std::vector<MeshProblem> degenerate, zero_area;
   for (int f = 0; f < nf; ++f) {
     const Eigen::Vector3i& t = tris[f];
     std::ostringstream os;
@@ -90,19 +90,22 @@ std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
       zero_area.push_back(make(MeshProblemKind::ZeroAreaFace, {f}, {t[0], t[1], t[2]},
                                "its corners are collinear or coincide"));
   }
+  return valid;
+}
 
-  // Edges: undirected key -> faces using it, with direction.
+/// Edges shared by more than two valid faces, or by two running the same way.
+void check_edges(const std::vector<Eigen::Vector3i>& tris, const std::vector<char>& valid,
+                 std::vector<MeshProblem>& nonmanifold_edge,
+                 std::vector<MeshProblem>& orientation) {
+  // Undirected key -> faces using it, with direction.
   std::map<std::pair<int, int>, std::vector<std::pair<int, bool>>> edges;
-  std::vector<std::vector<int>> vfaces(nv);
-  for (int f = 0; f < nf; ++f) {
+  for (int f = 0; f < static_cast<int>(tris.size()); ++f) {
     if (!valid[f]) continue;
     for (int k = 0; k < 3; ++k) {
       const int a = tris[f][k], b = tris[f][(k + 1) % 3];
       edges[{std::min(a, b), std::max(a, b)}].emplace_back(f, a < b);
-      vfaces[a].push_back(f);
     }
   }
-  std::vector<MeshProblem> nonmanifold_edge, orientation;
   for (const auto& [e, fs] : edges) {
     std::vector<int> faces;
     for (const auto& fd : fs) faces.push_back(fd.first);
@@ -115,10 +118,13 @@ std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
                                  "both faces run along the edge in the same direction"));
     }
   }
+}
 
-  // Vertex fans: faces around v joined through shared edges (v, x) must form one fan.
+/// Vertex fans: faces around v joined through shared edges (v, x) must form one fan.
+std::vector<MeshProblem> check_fans(const std::vector<Eigen::Vector3i>& tris,
+                                    const std::vector<std::vector<int>>& vfaces) {
   std::vector<MeshProblem> nonmanifold_vertex;
-  for (int v = 0; v < nv; ++v) {
+  for (int v = 0; v < static_cast<int>(vfaces.size()); ++v) {
     const std::vector<int>& fs = vfaces[v];
     if (fs.size() < 2) continue;
     std::vector<int> parent(fs.size());
@@ -142,8 +148,12 @@ std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
           make(MeshProblemKind::NonManifoldVertex, fs, {v},
                std::to_string(fans) + " separate fans of faces meet there"));
   }
+  return nonmanifold_vertex;
+}
 
-  // Exactly coincident vertices.
+/// Groups of exactly coincident vertices, ordered by their first vertex.
+std::vector<MeshProblem> check_duplicates(const std::vector<Vec3d>& vertices) {
+  const int nv = static_cast<int>(vertices.size());
   std::vector<MeshProblem> duplicate;
   std::vector<int> order(nv);
   std::iota(order.begin(), order.end(), 0);
@@ -167,12 +177,29 @@ std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
   std::sort(duplicate.begin(), duplicate.end(), [](const MeshProblem& a, const MeshProblem& b) {
     return a.vertices[0] < b.vertices[0];
   });
+  return duplicate;
+}
 
+}  // namespace
+
+std::vector<MeshProblem> check_shell_mesh(const std::vector<Vec3d>& vertices,
+                                          const std::vector<Eigen::Vector3i>& tris) {
+  const int nv = static_cast<int>(vertices.size());
+  std::vector<MeshProblem> degenerate, zero_area, nonmanifold_edge, orientation;
+  const std::vector<char> valid = check_faces(vertices, tris, degenerate, zero_area);
+  check_edges(tris, valid, nonmanifold_edge, orientation);
+  std::vector<std::vector<int>> vfaces(nv);  // valid faces around each vertex
+  for (int f = 0; f < static_cast<int>(tris.size()); ++f)
+    if (valid[f])
+      for (int k = 0; k < 3; ++k) vfaces[tris[f][k]].push_back(f);
+  std::vector<MeshProblem> nonmanifold_vertex = check_fans(tris, vfaces);
+  std::vector<MeshProblem> duplicate = check_duplicates(vertices);
   std::vector<MeshProblem> isolated;
   for (int v = 0; v < nv; ++v)
     if (vfaces[v].empty())
       isolated.push_back(make(MeshProblemKind::IsolatedVertex, {}, {v}, "used by no face"));
 
+  std::vector<MeshProblem> out;
   for (auto* group : {&nonmanifold_edge, &nonmanifold_vertex, &duplicate, &zero_area, &orientation,
                       &degenerate, &isolated})
     for (MeshProblem& p : *group) out.push_back(std::move(p));

@@ -128,29 +128,23 @@ std::unique_ptr<Eigen::SimplicialLDLT<SpMat>> factorise(const SpMat& K) {
   }
 }
 
-}  // namespace
-
-StaticSolveResult solve_static(std::vector<Vec3d>& x, const std::vector<std::uint8_t>& free_mask,
-                               const ForceFn& forces, const StaticSolveOptions& opt) {
-  SHELLMPM_CHECK(free_mask.size() == x.size(), << free_mask.size() << " vs " << x.size());
-  const bool newton = !opt.coupling.empty();
-  if (newton) SHELLMPM_CHECK(opt.coupling.size() == x.size(), << opt.coupling.size());
-  Problem pb{x, forces, {}, std::vector<int>(3 * x.size(), -1), {}, {}, 0};
-  std::vector<char> movable(x.size(), 0);
-  for (std::size_t i = 0; i < x.size(); ++i)
+/// Numbers the free (point, component) pairs of free_mask into pb.dofs / pb.dof_of;
+/// returns which points have a free component.
+std::vector<char> number_dofs(Problem& pb, const std::vector<std::uint8_t>& free_mask) {
+  std::vector<char> movable(pb.x.size(), 0);
+  for (std::size_t i = 0; i < pb.x.size(); ++i)
     for (int a = 0; a < 3; ++a)
       if (free_mask[i] & (1u << a)) {
         pb.dof_of[3 * i + a] = static_cast<int>(pb.dofs.size());
         pb.dofs.emplace_back(static_cast<int>(i), a);
         movable[i] = 1;
       }
-  StaticSolveResult res;
-  if (pb.dofs.empty()) {
-    res.converged = true;
-    return res;
-  }
-  // Length scale of the problem: the bounding-box diagonal (or the largest coordinate,
-  // or 1 for a single point at the origin).
+  return movable;
+}
+
+/// Length scale of the problem: the bounding-box diagonal (or the largest coordinate,
+/// or 1 for a single point at the origin).
+double length_scale(const std::vector<Vec3d>& x) {
   Eigen::AlignedBox<double, 3> box;
   double size = 0;
   for (const Vec3d& p : x) {
@@ -159,6 +153,107 @@ StaticSolveResult solve_static(std::vector<Vec3d>& x, const std::vector<std::uin
   }
   size = std::max(size, box.diagonal().norm());
   if (!(size > 0)) size = 1;
+  return size;
+}
+
+using History = std::deque<std::pair<VecX, VecX>>;  // (s, y)
+
+/// L-BFGS two-loop recursion (Nocedal & Wright 2006, alg. 7.4): d = -H g, with H0 the
+/// factorised stiffness when there is one, else the scaled identity.
+VecX two_loop(const History& hist, const Eigen::SimplicialLDLT<SpMat>* H0, const VecX& g,
+              double step_scale) {
+  VecX d = -g;
+  std::vector<double> alpha(hist.size());
+  for (int k = static_cast<int>(hist.size()) - 1; k >= 0; --k) {
+    const auto& [s, y] = hist[k];
+    alpha[k] = s.dot(d) / y.dot(s);
+    d -= alpha[k] * y;
+  }
+  if (H0) {
+    d = H0->solve(d);
+  } else if (!hist.empty()) {
+    const auto& [s, y] = hist.back();
+    d *= s.dot(y) / y.dot(y);
+  } else {
+    d *= step_scale;
+  }
+  for (std::size_t k = 0; k < hist.size(); ++k) {
+    const auto& [s, y] = hist[k];
+    const double beta = y.dot(d) / y.dot(s);
+    d += (alpha[k] - beta) * s;
+  }
+  return d;
+}
+
+/// The step direction d at gradient g (two_loop(); without history if that is not a
+/// descent direction), capped so no coordinate moves further than max_move: the first
+/// steps of a sagging drape see only bending stiffness and would go far out. dphi0 = g . d.
+VecX search_direction(History& hist, const Eigen::SimplicialLDLT<SpMat>* H0, const VecX& g,
+                      double step_scale, double max_move, double& dphi0) {
+  VecX d = two_loop(hist, H0, g, step_scale);
+  dphi0 = g.dot(d);
+  if (!(dphi0 < 0)) {  // not a descent direction: restart without history
+    hist.clear();
+    d = H0 ? VecX(-H0->solve(g)) : VecX(-step_scale * g);
+    dphi0 = g.dot(d);
+  }
+  const double dmax = d.lpNorm<Eigen::Infinity>();
+  if (dmax > max_move) {
+    d *= max_move / dmax;
+    dphi0 = g.dot(d);
+  }
+  return d;
+}
+
+/// Secant search on phi'(a) = g(q + a d) . d for a zero, starting at a = 1; a step to
+/// where the forces are not finite (an inverted element) is halved. Returns a and the
+/// gradient there in g_new.
+double secant_search(Problem& pb, const VecX& q, const VecX& d, double dphi0, VecX& g_new) {
+  double a_lo = 0, dphi_lo = dphi0, a = 1;
+  g_new = pb.gradient(q + a * d);
+  double dphi = g_new.dot(d);
+  for (int k = 0; k < 40 && !std::isfinite(dphi); ++k) {
+    a *= 0.5;
+    g_new = pb.gradient(q + a * d);
+    dphi = g_new.dot(d);
+  }
+  SHELLMPM_CHECK(std::isfinite(dphi), << "forces not finite near the current state");
+  for (int ls = 0; ls < 12 && std::abs(dphi) > 0.3 * std::abs(dphi0); ++ls) {
+    double a_next;
+    if (dphi < 0) {
+      a_next = (dphi_lo < dphi) ? a + (a - a_lo) * dphi / (dphi_lo - dphi) : 2 * a;
+      a_next = std::min(a_next, 4 * a);
+      a_lo = a;
+      dphi_lo = dphi;
+    } else {
+      a_next = a_lo + (a - a_lo) * dphi_lo / (dphi_lo - dphi);
+    }
+    if (!(a_next > 0) || !std::isfinite(a_next)) break;
+    const VecX g_try = pb.gradient(q + a_next * d);
+    const double dphi_try = g_try.dot(d);
+    if (!std::isfinite(dphi_try)) break;  // keep the last finite point
+    a = a_next;
+    g_new = g_try;
+    dphi = dphi_try;
+  }
+  return a;
+}
+
+}  // namespace
+
+StaticSolveResult solve_static(std::vector<Vec3d>& x, const std::vector<std::uint8_t>& free_mask,
+                               const ForceFn& forces, const StaticSolveOptions& opt) {
+  SHELLMPM_CHECK(free_mask.size() == x.size(), << free_mask.size() << " vs " << x.size());
+  const bool newton = !opt.coupling.empty();
+  if (newton) SHELLMPM_CHECK(opt.coupling.size() == x.size(), << opt.coupling.size());
+  Problem pb{x, forces, {}, std::vector<int>(3 * x.size(), -1), {}, {}, 0};
+  const std::vector<char> movable = number_dofs(pb, free_mask);
+  StaticSolveResult res;
+  if (pb.dofs.empty()) {
+    res.converged = true;
+    return res;
+  }
+  const double size = length_scale(x);
   const double max_move = opt.max_move * size;
   std::vector<std::vector<int>> groups;
   double eps = 0;
@@ -170,7 +265,7 @@ StaticSolveResult solve_static(std::vector<Vec3d>& x, const std::vector<std::uin
   VecX g = pb.gradient(q);
   std::unique_ptr<Eigen::SimplicialLDLT<SpMat>> H0;
   constexpr int kMemory = 12;
-  std::deque<std::pair<VecX, VecX>> hist;  // (s, y)
+  History hist;
   const double step_scale = 1e-3 / std::max(g.lpNorm<Eigen::Infinity>(), 1e-300);
   int since_refresh = 0;
   std::vector<double> best;  // best residual up to each iteration
@@ -193,69 +288,10 @@ StaticSolveResult solve_static(std::vector<Vec3d>& x, const std::vector<std::uin
       since_refresh = 0;
     }
     ++since_refresh;
-    // Two-loop recursion: d = -H g.
-    VecX d = -g;
-    std::vector<double> alpha(hist.size());
-    for (int k = static_cast<int>(hist.size()) - 1; k >= 0; --k) {
-      const auto& [s, y] = hist[k];
-      alpha[k] = s.dot(d) / y.dot(s);
-      d -= alpha[k] * y;
-    }
-    if (H0) {
-      d = H0->solve(d);
-    } else if (!hist.empty()) {
-      const auto& [s, y] = hist.back();
-      d *= s.dot(y) / y.dot(y);
-    } else {
-      d *= step_scale;
-    }
-    for (std::size_t k = 0; k < hist.size(); ++k) {
-      const auto& [s, y] = hist[k];
-      const double beta = y.dot(d) / y.dot(s);
-      d += (alpha[k] - beta) * s;
-    }
-    double dphi0 = g.dot(d);
-    if (!(dphi0 < 0)) {  // not a descent direction: restart without history
-      hist.clear();
-      d = H0 ? VecX(-H0->solve(g)) : VecX(-step_scale * g);
-      dphi0 = g.dot(d);
-    }
-    // Trust cap: no point moves further than max_move in one iteration (the first steps
-    // of a sagging drape see only bending stiffness and would go far out).
-    const double dmax = d.lpNorm<Eigen::Infinity>();
-    if (dmax > max_move) {
-      d *= max_move / dmax;
-      dphi0 = g.dot(d);
-    }
-    // Secant search on phi'(a) = g(q + a d) . d for a zero, starting at a = 1; a step to
-    // where the forces are not finite (an inverted element) is halved.
-    double a_lo = 0, dphi_lo = dphi0, a = 1;
-    VecX g_new = pb.gradient(q + a * d);
-    double dphi = g_new.dot(d);
-    for (int k = 0; k < 40 && !std::isfinite(dphi); ++k) {
-      a *= 0.5;
-      g_new = pb.gradient(q + a * d);
-      dphi = g_new.dot(d);
-    }
-    SHELLMPM_CHECK(std::isfinite(dphi), << "forces not finite near the current state");
-    for (int ls = 0; ls < 12 && std::abs(dphi) > 0.3 * std::abs(dphi0); ++ls) {
-      double a_next;
-      if (dphi < 0) {
-        a_next = (dphi_lo < dphi) ? a + (a - a_lo) * dphi / (dphi_lo - dphi) : 2 * a;
-        a_next = std::min(a_next, 4 * a);
-        a_lo = a;
-        dphi_lo = dphi;
-      } else {
-        a_next = a_lo + (a - a_lo) * dphi_lo / (dphi_lo - dphi);
-      }
-      if (!(a_next > 0) || !std::isfinite(a_next)) break;
-      const VecX g_try = pb.gradient(q + a_next * d);
-      const double dphi_try = g_try.dot(d);
-      if (!std::isfinite(dphi_try)) break;  // keep the last finite point
-      a = a_next;
-      g_new = g_try;
-      dphi = dphi_try;
-    }
+    double dphi0;
+    const VecX d = search_direction(hist, H0.get(), g, step_scale, max_move, dphi0);
+    VecX g_new;
+    const double a = secant_search(pb, q, d, dphi0, g_new);
     const VecX s = a * d;
     const VecX y = g_new - g;
     q += s;

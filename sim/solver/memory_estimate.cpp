@@ -291,19 +291,13 @@ double expected_source_particles(const SourceDesc& src, const ShotSettings& shot
   return per_volume * cross_section(src.shape, src.velocity / speed) * speed * duration;
 }
 
-SolverMemory estimate_solver_memory(const Scene& scene) {
-  SolverMemory out;
-  MemoryCounts& n = out.counts;
+namespace {
+
+/// Bulk particles and the blocks they occupy (at rest density; emitted material counted
+/// as a loose pile, half full) into n; returns the largest fill source's particle count.
+double add_bulk_counts(const Scene& scene, MemoryCounts& n) {
   const ShotSettings& shot = scene.shot;
   const double dx = shot.dx;
-
-  // Bulk particles and the blocks they occupy (at rest density; emitted material counted
-  // as a loose pile, half full).
-  bool plastic = false;
-  for (const MaterialDesc& m : scene.materials)
-    plastic = plastic || m.kind != MaterialKind::Elastic;
-  const double per_particle = 2 * kVec3 + 2 * kMat3 + R + 2 + 4 + (plastic ? R : 0);
-  out.bytes_per_particle = per_particle;
   double largest_fill = 0;
   for (const SourceDesc& src : scene.sources) {
     const double count = expected_source_particles(src, shot);
@@ -319,50 +313,60 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
                    n.grid_blocks);
     }
   }
+  return largest_fill;
+}
 
-  // Shells.
-  ShellTotals t;
-  for (std::size_t i = 0; i < scene.shells.size(); ++i) add_shell_memory(scene, i, n, t);
-  double fields_bytes = 0;
-  double integrity_bytes = t.integrity_bytes;
-  const double shells_persistent = t.shells_persistent, construction = t.construction;
-  const double grid_points = t.grid_points, force_scratch = t.force_scratch;
-  const double contact_bytes = t.contact_bytes, shell_bytes = t.shell_bytes;
-  const double guard_bytes = t.guard_bytes;
+/// Per-shell velocity fields (shot.shell_velocities: per_shell) when two bodies share the
+/// grid (two shells, a shell and bulk, or a shell's folds): each bins its control points
+/// into its own grid and keeps 6^3 buffers and 4^3 nodes of 14 Reals; the combined grid
+/// keeps the bulk moments. Fold blocks are transient and few (a crumple's folds cover a
+/// fraction of its blocks). 0 when the fields are off.
+double fields_memory(const Scene& scene, const ShellTotals& t, const MemoryCounts& n) {
+  const ShotSettings& shot = scene.shot;
   const std::size_t grid_shells = t.grid_shells;
   const bool fields_wanted = shot.shell_velocities == ShellVelocities::PerShell;
-  const std::vector<double>& shell_pblocks = t.shell_pblocks;
-  // Per-shell velocity fields (shot.shell_velocities: per_shell) when two bodies share the
-  // grid (two shells, a shell and bulk, or a shell's folds): each bins its control points into its
-  // own grid and keeps 6^3 buffers and 4^3 nodes of 14 Reals; the combined grid keeps the bulk
-  // moments. Fold blocks are transient and few (a crumple's folds cover a fraction of its blocks).
   const bool fields =
       fields_wanted &&
       (grid_shells >= 2 || (grid_shells >= 1 && (shot.fold_fields || !scene.sources.empty())));
-  if (fields) {
-    for (double pb : shell_pblocks) {
-      const double gb = 2.2 * pb;
-      fields_bytes += grid_bytes(0, pb, gb) + pb * 216 * 14 * R + gb * 64 * (14 * R + kVec3);
-    }
-    fields_bytes += 24 * n.shell_points + n.particle_blocks * 216 * 4 * R +
-                    n.grid_blocks * (64 * kVec3 + 64 * 4 * R + 4 * grid_shells + 1);
+  double fields_bytes = 0;
+  if (!fields) return fields_bytes;
+  for (double pb : t.shell_pblocks) {
+    const double gb = 2.2 * pb;
+    fields_bytes += grid_bytes(0, pb, gb) + pb * 216 * 14 * R + gb * 64 * (14 * R + kVec3);
   }
+  fields_bytes += 24 * n.shell_points + n.particle_blocks * 216 * 4 * R +
+                  n.grid_blocks * (64 * kVec3 + 64 * 4 * R + 4 * grid_shells + 1);
+  return fields_bytes;
+}
+
+}  // namespace
+
+SolverMemory estimate_solver_memory(const Scene& scene) {
+  SolverMemory out;
+  MemoryCounts& n = out.counts;
+  bool plastic = false;
+  for (const MaterialDesc& m : scene.materials)
+    plastic = plastic || m.kind != MaterialKind::Elastic;
+  const double per_particle = 2 * kVec3 + 2 * kMat3 + R + 2 + 4 + (plastic ? R : 0);
+  out.bytes_per_particle = per_particle;
+  const double largest_fill = add_bulk_counts(scene, n);
+  ShellTotals t;
+  for (std::size_t i = 0; i < scene.shells.size(); ++i) add_shell_memory(scene, i, n, t);
+  const double fields_bytes = fields_memory(scene, t, n);
 
   // The particles at the peak, and the combined grid.
   const double particles = per_particle * n.peak_particles();
   const double grid =
-      grid_bytes(n.peak_particles() + grid_points, n.particle_blocks, n.grid_blocks);
+      grid_bytes(n.peak_particles() + t.grid_points, n.particle_blocks, n.grid_blocks);
   // The integrity monitor records a side per particle and limit vertex once shells are on
   // the grid.
-  if (grid_shells > 0) integrity_bytes += 3 * n.peak_particles();
+  double integrity_bytes = t.integrity_bytes;
+  if (t.grid_shells > 0) integrity_bytes += 3 * n.peak_particles();
 
-  out.parts = {{"particles", particles},
-               {"grid", grid},
-               {"shells", shell_bytes},
-               {"contact", contact_bytes},
-               {"per-shell fields", fields_bytes},
-               {"integrity", integrity_bytes},
-               {"shell guard", guard_bytes}};
+  out.parts = {{"particles", particles},           {"grid", grid},
+               {"shells", t.shell_bytes},          {"contact", t.contact_bytes},
+               {"per-shell fields", fields_bytes}, {"integrity", integrity_bytes},
+               {"shell guard", t.guard_bytes}};
   double held = 0;
   for (const MemoryPart& p : out.parts) held += p.bytes;
   // A step: the adjoints of the largest shell's forces; an emitting run also copies one
@@ -374,14 +378,14 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   // Contact and integrity scratch of a step (measured: about 200 bytes per contact site).
   const double contact_scratch = 200 * n.contact_sites;
   out.held_bytes = held;
-  out.step_scratch = std::max({force_scratch + contact_scratch, growth, permute});
+  out.step_scratch = std::max({t.force_scratch + contact_scratch, growth, permute});
   // Built: the shells one by one, then contact and integrity, then the fill particles
   // (each source's points in a vector of Vec3d, doubled by push_back, before they move
   // into the particle arrays).
-  const double after_shells = shells_persistent + contact_bytes + integrity_bytes;
+  const double after_shells = t.shells_persistent + t.contact_bytes + integrity_bytes;
   const double fill = after_shells + per_particle * n.fill_particles +
                       std::max(2 * 24 * largest_fill, kMat3 * n.fill_particles);
-  out.construction_bytes = std::max(construction, fill);
+  out.construction_bytes = std::max(t.construction, fill);
   return out;
 }
 

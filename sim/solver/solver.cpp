@@ -1,6 +1,7 @@
 #include "sim/solver/solver.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -103,11 +104,10 @@ double Solver::stable_dt(double* vmax_out) const {
   const std::size_t n = c_.particles.size();
   double vmax = 0, cmax = 0;
   if (n > 0) {
-    const std::size_t chunks = (n + kParticleGrain - 1) / kParticleGrain;
-    std::vector<double> vm(chunks, 0.0), cm(chunks, 0.0);
-    parallel_for(
-        n, kParticleGrain,
-        [&](std::size_t b, std::size_t e) {
+    // Per chunk: the largest speed (NaN if one is not finite) and wave speed.
+    const std::vector<std::array<double, 2>> parts = chunk_parts(
+        n, kParticleGrain, c_.opt.serial, std::array<double, 2>{0.0, 0.0},
+        [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
           // Squared wave speeds, from the deformed state F (a material stiffens or softens
           // as it is squeezed); one square root per chunk.
           Real v2 = 0, c2 = 0;
@@ -122,15 +122,16 @@ double Solver::stable_dt(double* vmax_out) const {
                                   c_.particles.has_plastic() ? c_.particles.plastic[p] : Real(1)) /
                                   c_.densities[mat]);
           }
-          vm[b / kParticleGrain] = finite ? std::sqrt(static_cast<double>(v2))
-                                          : std::numeric_limits<double>::quiet_NaN();
-          cm[b / kParticleGrain] = std::sqrt(c2);
-        },
-        c_.opt.serial);
-    for (double v : vm)
-      if (!std::isfinite(v)) return v;  // diverged
-    vmax = *std::max_element(vm.begin(), vm.end());
-    cmax = *std::max_element(cm.begin(), cm.end());
+          part[0] = finite ? std::sqrt(static_cast<double>(v2))
+                           : std::numeric_limits<double>::quiet_NaN();
+          part[1] = std::sqrt(c2);
+        });
+    for (const std::array<double, 2>& part : parts)
+      if (!std::isfinite(part[0])) return part[0];  // diverged
+    for (const std::array<double, 2>& part : parts) {
+      vmax = std::max(vmax, part[0]);
+      cmax = std::max(cmax, part[1]);
+    }
   }
   for (const GridShell& g : c_.grid_shells)
     for (const Vec3& v : g.shell->v) {

@@ -22,12 +22,9 @@ void StepContext::clamp_to_domain() {
     lo[a] = static_cast<Real>(s.domain_min[a] + s.dx);
     hi[a] = static_cast<Real>(s.domain_min[a] + (domain_cells[a] - 1) * s.dx);
   }
-  parallel_for(
+  parallel_for_each(
       particles.size(), kParticleGrain,
-      [&](std::size_t b, std::size_t e) {
-        for (std::size_t p = b; p < e; ++p)
-          particles.x[p] = particles.x[p].cwiseMax(lo).cwiseMin(hi);
-      },
+      [&](std::size_t p) { particles.x[p] = particles.x[p].cwiseMax(lo).cwiseMin(hi); },
       opt.serial);
   for (GridShell& g : grid_shells) {
     for (Vec3& x : g.shell->x) x = x.cwiseMax(lo).cwiseMin(hi);
@@ -36,16 +33,15 @@ void StepContext::clamp_to_domain() {
 }
 
 void StepContext::apply_walls() {
-  parallel_for(
+  parallel_for_each(
       grid.num_grid_blocks(), 16,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b)
-          grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
-            for (int a = 0; a < 3; ++a) {
-              if (n[a] < kWallCells && nd.v[a] < 0) nd.v[a] = 0;
-              if (n[a] > domain_cells[a] - kWallCells && nd.v[a] > 0) nd.v[a] = 0;
-            }
-          });
+      [&](std::size_t b) {
+        grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
+          for (int a = 0; a < 3; ++a) {
+            if (n[a] < kWallCells && nd.v[a] < 0) nd.v[a] = 0;
+            if (n[a] > domain_cells[a] - kWallCells && nd.v[a] > 0) nd.v[a] = 0;
+          }
+        });
       },
       opt.serial);
 }

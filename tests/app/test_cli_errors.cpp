@@ -10,18 +10,7 @@ using namespace shellmpm_test;
 
 namespace {
 
-const char* kGood = R"(version: 1
-shot:
-  frames: [1, 3]
-  dx: 0.05
-  domain: {min: [-0.5, 0, -0.5], max: [0.5, 1, 0.5]}
-materials:
-  - {name: jelly, type: elastic, youngs_modulus: 1.0e4, poisson_ratio: 0.3, density: 1000}
-sources:
-  - {material: jelly, shape: {type: box, min: [-0.1, 0.3, -0.1], max: [0.1, 0.5, 0.1]}}
-output:
-  directory: OUT
-)";
+const std::string kGood = jelly_scene(3, "", "OUT");
 
 std::string scene_with(const TempDir& d, std::string text, const std::string& from = "",
                        const std::string& to = "") {

@@ -19,19 +19,7 @@ using namespace shellmpm_test;
 
 namespace {
 
-const char* kJelly = R"(version: 1
-shot:
-  frames: [1, 40]
-  dx: 0.05
-  domain: {min: [-0.5, 0, -0.5], max: [0.5, 1, 0.5]}
-materials:
-  - {name: jelly, type: elastic, youngs_modulus: 1.0e4, poisson_ratio: 0.3, density: 1000}
-sources:
-  - {material: jelly, shape: {type: box, min: [-0.1, 0.3, -0.1], max: [0.1, 0.5, 0.1]}}
-output:
-  directory: OUT
-  particles: true
-)";
+const std::string kJelly = jelly_scene(40, "", "OUT", "  particles: true\n");
 
 std::string make_scene(const TempDir& d) {
   std::string t = kJelly;

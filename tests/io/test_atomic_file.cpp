@@ -25,16 +25,10 @@
 
 using namespace shellmpm;
 using shellmpm_test::FileSizeLimit;
+using shellmpm_test::read_text;
 using shellmpm_test::TempDir;
 
 namespace {
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// `n` particles in a random cloud of width `size` [m], so that every cache grows with n.
 ParticleSet cloud(std::size_t n, double size = 1.0) {
@@ -153,7 +147,7 @@ TEST_CASE("CheckedFile writes through write() and a seekable stream", "[atomic]"
     f.write("!", 1);
     f.close();
   }
-  CHECK(slurp(path) == "Jello world!");
+  CHECK(read_text(path) == "Jello world!");
   CHECK_THROWS_AS(CheckedFile(dir.file("missing/a.bin")), std::system_error);
 }
 
@@ -166,7 +160,7 @@ TEST_CASE(
       TempDir dir("atomic_limit");
       const std::string path = dir.file(w.file);
       w.write(path, false);
-      const std::string before = slurp(path);
+      const std::string before = read_text(path);
       REQUIRE(!before.empty());
       // The large output really is larger than the limit (so the failure below can only
       // come from the limit), and writes fine without it.
@@ -189,7 +183,7 @@ TEST_CASE(
       INFO(error);
       CHECK(!error.empty());
       CHECK(error.find(w.file) != std::string::npos);
-      CHECK(slurp(path) == before);
+      CHECK(read_text(path) == before);
       CHECK(dir.temp_files() == 0);
     }
   }

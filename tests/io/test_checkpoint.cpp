@@ -18,19 +18,14 @@
 #include "io/checksum.h"
 #include "io/scene_reader.h"
 #include "sim/solver/solver.h"
+#include "tests/support/jelly_scene.h"
 #include "tests/support/temp_dir.h"
 
 using namespace shellmpm;
+using shellmpm_test::read_text;
 using shellmpm_test::TempDir;
 
 namespace {
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// A small checkpoint with every section filled: 3 plastic particles, one shell with
 /// plastic state and contact data.
@@ -88,17 +83,7 @@ void expect_refused(const TempDir& dir, const Checkpoint& c, const std::string& 
   CHECK(m.find(what) != std::string::npos);
 }
 
-const char* kScene = R"(version: 1
-shot:
-  frames: [1, 5]
-  fps: 24
-  dx: 0.05
-  domain: {min: [-0.5, 0, -0.5], max: [0.5, 1, 0.5]}
-materials:
-  - {name: jelly, type: elastic, youngs_modulus: 1.0e4, poisson_ratio: 0.3, density: 1000}
-sources:
-  - {material: jelly, shape: {type: box, min: [-0.1, 0.3, -0.1], max: [0.1, 0.5, 0.1]}}
-)";
+const std::string kScene = shellmpm_test::jelly_scene(5, "  fps: 24\n", "");
 
 /// A checkpoint of the solver's initial state, written as for frame 3.
 Checkpoint of_solver(const Solver& s) {
@@ -166,7 +151,7 @@ TEST_CASE("every damaged byte, truncation and extension of a checkpoint is refus
   TempDir dir("ck_damage");
   const std::string good_path = dir.file("good.bin");
   write_checkpoint(good_path, small_checkpoint());
-  const std::string good = slurp(good_path);
+  const std::string good = read_text(good_path);
   REQUIRE(damage_message(good_path).empty());
   const std::string path = dir.file("checkpoint.0003.bin");
   auto refused = [&](const std::string& bytes) {

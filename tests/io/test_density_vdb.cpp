@@ -21,16 +21,10 @@
 
 namespace fs = std::filesystem;
 using namespace shellmpm;
+using shellmpm_test::read_text;
 using shellmpm_test::TempDir;
 
 namespace {
-
-std::string slurp(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
 
 /// Particles on a regular lattice of spacing h/2 (8 per cell) filling the cells
 /// [lo, hi)^3, each of volume (h/2)^3: packed material.
@@ -118,12 +112,12 @@ TEST_CASE("atomic writes leave no temporaries and never clobber on failure", "[v
   TempDir dir("atomic");
   const std::string path = dir.file("stats.json");
   write_text_atomic(path, "first\n");
-  CHECK(slurp(path) == "first\n");
+  CHECK(read_text(path) == "first\n");
   write_text_atomic(path, "second\n");
-  CHECK(slurp(path) == "second\n");
+  CHECK(read_text(path) == "second\n");
   const unsigned char bytes[4] = {0, 1, 2, 255};
   write_bytes_atomic(dir.file("b.bin"), bytes, sizeof bytes);
-  CHECK(slurp(dir.file("b.bin")) == std::string("\0\1\2\377", 4));
+  CHECK(read_text(dir.file("b.bin")) == std::string("\0\1\2\377", 4));
   CHECK(dir.temp_files() == 0);
 
   // A writer that fails halfway: the old file stays, the temporary goes.
@@ -133,12 +127,12 @@ TEST_CASE("atomic writes leave no temporaries and never clobber on failure", "[v
                                         throw std::runtime_error("killed");
                                       }),
                     "killed");
-  CHECK(slurp(path) == "second\n");
+  CHECK(read_text(path) == "second\n");
   CHECK(dir.temp_files() == 0);
 
   // A writer that creates nothing is an error too, and leaves the target alone.
   CHECK_THROWS(write_file_atomic(path, [](const std::string&) {}));
-  CHECK(slurp(path) == "second\n");
+  CHECK(read_text(path) == "second\n");
   // An unwritable target directory.
   CHECK_THROWS(write_text_atomic(dir.file("missing/dir/x.txt"), "x"));
   CHECK(dir.temp_files() == 0);

@@ -12,25 +12,23 @@ bool CollidersStage::needed(const Scene& s) {
 void CollidersStage::run(StepContext& c) {
   for (Collider& col : c.colliders) col.begin_step(c.time, c.dt);
   const double dx = c.grid.dx();
-  parallel_for(
+  parallel_for_each(
       c.grid.num_grid_blocks(), 16,
-      [&](std::size_t bb, std::size_t be) {
-        for (std::size_t b = bb; b < be; ++b) {
-          const Vec3i corner = unpack_block(c.grid.gblock_key[b]) * kBlockSize;
-          Aabb box;
-          box.lo = c.grid.node_position(corner).array() - dx;
-          box.hi = c.grid.node_position(corner + Vec3i::Constant(kBlockSize - 1)).array() + dx;
-          for (const Collider& col : c.colliders) {
-            if (!col.bounds().overlaps(box)) continue;
-            c.grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
-              Vec3 v(nd.v[0], nd.v[1], nd.v[2]);
-              if (col.apply(c.grid.node_position(n), v)) {
-                nd.v[0] = v[0];
-                nd.v[1] = v[1];
-                nd.v[2] = v[2];
-              }
-            });
-          }
+      [&](std::size_t b) {
+        const Vec3i corner = unpack_block(c.grid.gblock_key[b]) * kBlockSize;
+        Aabb box;
+        box.lo = c.grid.node_position(corner).array() - dx;
+        box.hi = c.grid.node_position(corner + Vec3i::Constant(kBlockSize - 1)).array() + dx;
+        for (const Collider& col : c.colliders) {
+          if (!col.bounds().overlaps(box)) continue;
+          c.grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
+            Vec3 v(nd.v[0], nd.v[1], nd.v[2]);
+            if (col.apply(c.grid.node_position(n), v)) {
+              nd.v[0] = v[0];
+              nd.v[1] = v[1];
+              nd.v[2] = v[2];
+            }
+          });
         }
       },
       c.opt.serial);
