@@ -25,11 +25,7 @@ int converge_command(const ConvergeArgs& a) {
   o.output = a.output;
   o.threads = a.threads < 0 ? 0 : a.threads;
   o.keep_runs = a.keep_runs;
-  if (a.verbosity != Verbosity::Quiet)
-    o.log = [](const std::string& m) {
-      std::printf("%s\n", m.c_str());
-      std::fflush(stdout);
-    };
+  if (a.verbosity != Verbosity::Quiet) o.log = print_line;
   std::filesystem::create_directories(o.output);
   const ConvergeResult r = run_convergence(o);
   write_text_atomic(o.output + "/converge.json", convergence_json(r));

@@ -80,4 +80,9 @@ void Progress::finish() {
   line_open_ = false;
 }
 
+void print_line(const std::string& m) {
+  std::printf("%s\n", m.c_str());
+  std::fflush(stdout);
+}
+
 }  // namespace shellmpm

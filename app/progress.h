@@ -11,6 +11,10 @@ namespace shellmpm {
 
 enum class Verbosity { Quiet, Normal, Verbose };
 
+/// One line on stdout, flushed at once (the study's and converge's progress, which may be
+/// piped to a log while the runs take minutes).
+void print_line(const std::string& m);
+
 class Progress {
  public:
   Progress(Verbosity v, int first_frame, int last_frame);

@@ -22,11 +22,7 @@ int study_command(const StudyArgs& a) {
   o.budget_seconds = a.budget;
   o.quick = a.quick;
   o.keep_runs = a.keep_runs;
-  if (a.verbosity != Verbosity::Quiet)
-    o.log = [](const std::string& m) {
-      std::printf("%s\n", m.c_str());
-      std::fflush(stdout);
-    };
+  if (a.verbosity != Verbosity::Quiet) o.log = print_line;
   std::filesystem::create_directories(o.output);
   const StudyResults r = run_study(o);
   write_study_report(r, o.output);

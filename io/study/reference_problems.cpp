@@ -56,6 +56,17 @@ StudySweep int_sweep(const std::string& name, const std::string& key, std::vecto
   return w;
 }
 
+/// A refinement of shot.dx alone (bulk problems: the particles follow the grid).
+StudySweep dx_sweep(std::vector<double> values, const std::string& held) {
+  StudySweep w;
+  w.name = "grid spacing";
+  w.varied = "shot.dx";
+  w.held = held;
+  w.refinement = true;
+  for (double h : values) w.settings.push_back({"dx=" + num(h), {"shot.dx=" + num(h)}, h});
+  return w;
+}
+
 StudySweep number_sweep(const std::string& name, const std::string& key, std::vector<double> values,
                         const std::string& held) {
   StudySweep w;
@@ -332,14 +343,7 @@ ReferenceProblem sand_column() {
     for (const Vec3d& x : r.particles(r.last_frame())) front = std::max(front, x.x());
     return front - wall;
   };
-  StudySweep dx;
-  dx.name = "grid spacing";
-  dx.varied = "shot.dx";
-  dx.held = "8 particles per cell";
-  dx.refinement = true;
-  for (double h : {0.02, 0.01, 0.005})
-    dx.settings.push_back({"dx=" + num(h), {"shot.dx=" + num(h)}, h});
-  p.sweeps.push_back(dx);
+  p.sweeps.push_back(dx_sweep({0.02, 0.01, 0.005}, "8 particles per cell"));
   p.sweeps.push_back(
       number_sweep("particles per cell", "sources[0].particles_per_cell", {4, 8, 16}, "dx 0.01"));
   return p;
@@ -369,14 +373,7 @@ ReferenceProblem bar_impact() {
     if (!a || !b) throw std::runtime_error(r.dir() + ": the bar did not rebound");
     return 2 * (*b - *a);
   };
-  StudySweep dx;
-  dx.name = "grid spacing";
-  dx.varied = "shot.dx";
-  dx.held = "8 particles per cell, APIC, CFL 0.3";
-  dx.refinement = true;
-  for (double h : {0.02, 0.01, 0.005})
-    dx.settings.push_back({"dx=" + num(h), {"shot.dx=" + num(h)}, h});
-  p.sweeps.push_back(dx);
+  p.sweeps.push_back(dx_sweep({0.02, 0.01, 0.005}, "8 particles per cell, APIC, CFL 0.3"));
   p.sweeps.push_back(number_sweep("particles per cell", "sources[0].particles_per_cell", {1, 8, 27},
                                   "dx 0.01, APIC, CFL 0.3"));
   StudySweep tr;
