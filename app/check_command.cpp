@@ -96,6 +96,18 @@ void print_shells(const Solver& solver) {
 /// dt_min (the run would stop).
 void print_time(const Solver& solver, const RunMemory& mem) {
   const ShotSettings& s = solver.scene().shot;
+  if (s.integrator == Integrator::Implicit) {
+    // No wave-speed bound: the step follows motion, the frame and the Newton solves.
+    std::printf(
+        "integrator: implicit (backward Euler, Newton with PCG, %s preconditioner): steps of "
+        "up to dt_max = %.3g s (%.3g per frame), shortened where cfl dx / max speed is "
+        "smaller and halved where a Newton solve does not converge to %g m/s in %d "
+        "iterations; the time per frame depends on those solves (stats.json: implicit)\n",
+        word_of(s.implicit_preconditioner).c_str(), s.dt_max, s.dt_max * s.fps,
+        s.implicit_tolerance, s.newton_max_iterations);
+    (void)mem;
+    return;
+  }
   // The step and what a frame costs: the solver's bounds on the current particles and
   // shells, plus the speeds and wave speeds (at rest) of what the sources are still to emit.
   const ShotEstimate est =

@@ -20,6 +20,7 @@
 #include "io/scene_sections.h"
 #include "io/utf8.h"
 #include "sim/core/check.h"
+#include "sim/solver/stages/scene_rules.h"
 
 namespace shellmpm {
 namespace {
@@ -80,6 +81,9 @@ void read_shot(const DocNode& node, ShotSettings& shot) {
   MapReader d(*r.block("domain"), "shot.domain", "shot.domain", false);
   d.fill(shot);
   d.finish();
+  // The implicit integrator's steps are bounded by motion and the frame, not by dt_max's
+  // explicit default: unless given, dt_max is one frame there.
+  if (shot.integrator == Integrator::Implicit && !r.has("dt_max")) shot.dt_max = 1.0 / shot.fps;
   check_shot_timing(r, shot);
   check_shot_domain(r, d, shot);
   r.finish();
@@ -200,6 +204,22 @@ void read_render(const DocNode& node, const Scene& scene, RenderSettings& rs) {
   r.finish();
 }
 
+/// The implicit integrator steps shells without contact (so far, docs/implicit.md): a
+/// scene that needs the grid (bulk sources, shells in contact) is refused at
+/// shot.integrator, never run half explicit.
+void check_integrator(const DocNode& shot_node, const Scene& scene) {
+  if (scene.shot.integrator != Integrator::Implicit || !grid_needed(scene)) return;
+  std::string what;
+  if (!scene.sources.empty()) what = "bulk material (sources)";
+  for (std::size_t i = 0; i < scene.shells.size() && what.empty(); ++i)
+    if (shell_has_contact(scene, i)) what = "shell '" + scene.shells[i].name + "' in contact";
+  MapReader r(shot_node, "shot", "shot", false);
+  fail(r.origin_of("integrator"), r.path_of("integrator"),
+       "implicit steps shells without contact only so far, and this scene has " + what +
+           " (shells are in contact when the scene has colliders, sources or another shell, "
+           "unless contact: off); use explicit, see docs/implicit.md");
+}
+
 Scene build_scene(const DocNode& root, const std::string& path) {
   Scene scene;
   scene.path = path;
@@ -215,6 +235,7 @@ Scene build_scene(const DocNode& root, const std::string& path) {
   read_preroll(*top.block("preroll"), scene.preroll);
   read_output(*top.block("output"), scene, scene.output);
   read_render(*top.block("render"), scene, scene.render);
+  check_integrator(*top.block("shot"), scene);
   top.finish();
   return scene;
 }

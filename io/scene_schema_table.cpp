@@ -73,7 +73,7 @@ std::vector<KeySpec> build_schema() {
           .def("1e-2")
           .unit("s")
           .gt(0)
-          .rule(">= dt_min"),
+          .rule(">= dt_min; with shot.integrator implicit the default is one frame (1 / fps)"),
       Spec("shot.gravity", T::Vec3)
           .to(&ShotSettings::gravity)
           .def("[0, -9.81, 0]")
@@ -114,6 +114,29 @@ std::vector<KeySpec> build_schema() {
           .ge(0)
           .le(1e3)
           .rule("0: the larger of 0.05 dx and the thickest contact shell"),
+      Spec("shot.integrator", T::Enum)
+          .to(&ShotSettings::integrator)
+          .def("explicit")
+          .rule("see docs/implicit.md"),
+      Spec("shot.implicit_tolerance", T::Number)
+          .to(&ShotSettings::implicit_tolerance)
+          .def("1e-4")
+          .unit("m/s")
+          .gt(0)
+          .le(1e3),
+      Spec("shot.newton_max_iterations", T::Int)
+          .to(&ShotSettings::newton_max_iterations)
+          .def("30")
+          .ge(1)
+          .le(10000),
+      Spec("shot.cg_max_iterations", T::Int)
+          .to(&ShotSettings::cg_max_iterations)
+          .def("500")
+          .ge(1)
+          .le(1000000),
+      Spec("shot.implicit_preconditioner", T::Enum)
+          .to(&ShotSettings::implicit_preconditioner)
+          .def("factorised"),
       Spec("shot.units", T::String).to(&ShotSettings::units).def("m").nonempty(),
       Spec("shot.on_integrity_failure", T::Enum)
           .to(&ShotSettings::on_integrity_failure)

@@ -38,6 +38,17 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     j["guard_zoned"] = s.guard_zoned;
     j["guard_unresolved"] = s.guard_unresolved;
   }
+  if (s.implicit) {
+    const ImplicitStats& im = s.implicit_stats;
+    nlohmann::json j_im;
+    j_im["steps"] = im.steps;
+    j_im["newton_iterations"] = im.newton_iterations;
+    j_im["max_newton_iterations"] = im.max_newton_iterations;
+    j_im["cg_iterations"] = im.cg_iterations;
+    j_im["max_residual"] = im.max_residual;
+    j_im["retries"] = im.retries;
+    j["implicit"] = j_im;
+  }
   if (s.integrity.active) {
     const IntegrityReport& r = s.integrity;
     nlohmann::json in;

@@ -25,6 +25,13 @@ enum class Quality { Draft, Preview, Production, Final };
 enum class ShellVelocities { PerShell, Shared };
 
 /// Shot-wide settings.
+/// How a step advances: explicit (symplectic Euler, steps bounded by the fastest elastic
+/// wave) or implicit (backward Euler by Newton's method, sim/implicit/; steps bounded by
+/// motion, the frame and the Newton cap).
+enum class Integrator { Explicit, Implicit };
+/// The implicit shell step's CG preconditioner (sim/implicit/shell_step.h).
+enum class ImplicitPreconditioner { Factorised, BlockJacobi };
+
 struct ShotSettings {
   int frame_start = 1;             ///< first frame written; frame f is the state at t = (f-1)/fps
   int frame_end = 48;              ///< last frame written, inclusive
@@ -50,6 +57,13 @@ struct ShotSettings {
   bool shell_guard = true;
   double shell_guard_gap = 0;  ///< [m]; 0: the larger of 0.05 dx and the thickest contact shell
   std::string units = "m";     ///< informational, written to VDB metadata
+  Integrator integrator = Integrator::Explicit;
+  /// Implicit: a Newton solve has converged when no velocity correction it asks for
+  /// exceeds this [m/s].
+  double implicit_tolerance = 1e-4;
+  int newton_max_iterations = 30;  ///< implicit: Newton iterations before a step is retried
+  int cg_max_iterations = 500;     ///< implicit: CG iterations per Newton iteration
+  ImplicitPreconditioner implicit_preconditioner = ImplicitPreconditioner::Factorised;
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
   enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;

@@ -31,6 +31,10 @@ struct EnumWords;
   }
 
 SHELLMPM_ENUM_WORDS(Transfer, 2, {"apic", Transfer::Apic}, {"mls", Transfer::Mls});
+SHELLMPM_ENUM_WORDS(Integrator, 2, {"explicit", Integrator::Explicit},
+                    {"implicit", Integrator::Implicit});
+SHELLMPM_ENUM_WORDS(ImplicitPreconditioner, 2, {"factorised", ImplicitPreconditioner::Factorised},
+                    {"block_jacobi", ImplicitPreconditioner::BlockJacobi});
 SHELLMPM_ENUM_WORDS(Quality, 4, {"draft", Quality::Draft}, {"preview", Quality::Preview},
                     {"production", Quality::Production}, {"final", Quality::Final});
 SHELLMPM_ENUM_WORDS(ShellVelocities, 2, {"per_shell", ShellVelocities::PerShell},

@@ -153,41 +153,59 @@ KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector
   return e;
 }
 
-StaticSolveResult ShellObject::settle(const Vec3d& gravity, double time, double tolerance,
-                                      int max_iterations, bool serial) {
+std::unique_ptr<KirchhoffLoveShellT<double>> ShellObject::double_kl(
+    std::vector<std::vector<int>>* coupling) const {
   const std::size_t n = x.size();
-  // A double copy of the elastic data, with the current plastic state.
   std::vector<BasisPoint> pts;
   std::vector<double> weights;
   quadrature_points(*basis_, static_cast<int>(tris_.size()), mat_.quadrature_inplane, pts, weights);
+  if (coupling) {
+    // Points sharing a quadrature point (the union over each face's points).
+    coupling->assign(n, {});
+    const std::size_t per_face = pts.size() / std::max<std::size_t>(tris_.size(), 1);
+    std::vector<int> face_ctrl;
+    for (std::size_t f = 0; f < tris_.size(); ++f) {
+      face_ctrl.clear();
+      for (std::size_t q = f * per_face; q < (f + 1) * per_face; ++q)
+        face_ctrl.insert(face_ctrl.end(), pts[q].ctrl.begin(), pts[q].ctrl.end());
+      std::sort(face_ctrl.begin(), face_ctrl.end());
+      face_ctrl.erase(std::unique(face_ctrl.begin(), face_ctrl.end()), face_ctrl.end());
+      for (int j : face_ctrl)
+        (*coupling)[j].insert((*coupling)[j].end(), face_ctrl.begin(), face_ctrl.end());
+    }
+    for (std::size_t j = 0; j < n; ++j) {
+      std::vector<int>& c = (*coupling)[j];
+      c.push_back(static_cast<int>(j));
+      std::sort(c.begin(), c.end());
+      c.erase(std::unique(c.begin(), c.end()), c.end());
+    }
+  }
+  auto kl = std::make_unique<KirchhoffLoveShellT<double>>(std::move(pts), std::move(weights), rest,
+                                                          mat_, mat_.quadrature_thickness);
+  sync_double_kl(*kl);
+  return kl;
+}
+
+void ShellObject::sync_double_kl(KirchhoffLoveShellT<double>& kl) const {
+  if (!kl.has_plasticity()) return;
+  const std::vector<Real>& fp = kl_->plastic_state();
+  kl.set_plastic_state(std::vector<double>(fp.begin(), fp.end()));
+}
+
+void ShellObject::external_forces(const Vec3d& gravity, const std::vector<Vec3d>& at,
+                                  std::vector<Vec3d>& f) const {
+  f.assign(at.size(), Vec3d::Zero());
+  add_loads(desc_, tris_, mass, gravity, at, f);
+}
+
+StaticSolveResult ShellObject::settle(const Vec3d& gravity, double time, double tolerance,
+                                      int max_iterations, bool serial) {
+  const std::size_t n = x.size();
   StaticSolveOptions opt;
   opt.tolerance = tolerance;
   opt.max_iterations = max_iterations;
-  // Coupling: points sharing a quadrature point (the union over each face's points).
-  opt.coupling.assign(n, {});
-  const std::size_t per_face = pts.size() / std::max<std::size_t>(tris_.size(), 1);
-  std::vector<int> face_ctrl;
-  for (std::size_t f = 0; f < tris_.size(); ++f) {
-    face_ctrl.clear();
-    for (std::size_t q = f * per_face; q < (f + 1) * per_face; ++q)
-      face_ctrl.insert(face_ctrl.end(), pts[q].ctrl.begin(), pts[q].ctrl.end());
-    std::sort(face_ctrl.begin(), face_ctrl.end());
-    face_ctrl.erase(std::unique(face_ctrl.begin(), face_ctrl.end()), face_ctrl.end());
-    for (int j : face_ctrl)
-      opt.coupling[j].insert(opt.coupling[j].end(), face_ctrl.begin(), face_ctrl.end());
-  }
-  for (std::size_t j = 0; j < n; ++j) {
-    std::vector<int>& c = opt.coupling[j];
-    c.push_back(static_cast<int>(j));
-    std::sort(c.begin(), c.end());
-    c.erase(std::unique(c.begin(), c.end()), c.end());
-  }
-  KirchhoffLoveShellT<double> kl(std::move(pts), std::move(weights), rest, mat_,
-                                 mat_.quadrature_thickness);
-  if (kl.has_plasticity()) {
-    const std::vector<Real>& fp = kl_->plastic_state();
-    kl.set_plastic_state(std::vector<double>(fp.begin(), fp.end()));
-  }
+  const std::unique_ptr<KirchhoffLoveShellT<double>> kl_ptr = double_kl(&opt.coupling);
+  const KirchhoffLoveShellT<double>& kl = *kl_ptr;
   // Pinned components at the pin pose at `time` (released pins are free).
   std::vector<Vec3d> xd(n);
   std::vector<std::uint8_t> free_mask(n, 7);
@@ -213,6 +231,19 @@ StaticSolveResult ShellObject::settle(const Vec3d& gravity, double time, double 
     v[i].setZero();
   }
   return r;
+}
+
+void ShellObject::pin_targets(double t, double dt, std::vector<std::uint8_t>& held,
+                              std::vector<Vec3d>& target) const {
+  held.assign(x.size(), 0);
+  target.assign(x.size(), Vec3d::Zero());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (!pin_mask[i]) continue;
+    const PinDesc& pin = desc_.pins[pin_of[i]];
+    if (pin.release_time && t >= *pin.release_time) continue;
+    held[i] = pin_mask[i];
+    target[i] = keyframe_pose(pin.keyframes, t + dt).apply(rest[i]);
+  }
 }
 
 void ShellObject::integrate(const std::vector<Vec3>& f, double t, double dt, bool serial) {

@@ -44,6 +44,20 @@ class ShellObject {
   /// state is kept (no return mapping).
   StaticSolveResult settle(const Vec3d& gravity, double time, double tolerance, int max_iterations,
                            bool serial);
+  /// A double copy of the Kirchhoff-Love data with the current plastic state (the
+  /// static solve and the implicit step evaluate in double); with `coupling`, also which
+  /// points share a quadrature point (coupling[j]: every point whose force depends on j).
+  std::unique_ptr<KirchhoffLoveShellT<double>> double_kl(
+      std::vector<std::vector<int>>* coupling = nullptr) const;
+  /// Copies the current plastic state into a double copy made by double_kl.
+  void sync_double_kl(KirchhoffLoveShellT<double>& kl) const;
+  /// Gravity, pressure and point loads (no elastic force) at positions `at` into f.
+  void external_forces(const Vec3d& gravity, const std::vector<Vec3d>& at,
+                       std::vector<Vec3d>& f) const;
+  /// The pins over a step from t to t + dt: held[i], the components of point i a pin
+  /// holds (0 once its pin is released at t), and target[i], where its pin puts it at t + dt.
+  void pin_targets(double t, double dt, std::vector<std::uint8_t>& held,
+                   std::vector<Vec3d>& target) const;
   /// One symplectic Euler step with the forces f: damping, pins at time t + dt.
   void integrate(const std::vector<Vec3>& f, double t, double dt, bool serial);
   /// Denting return mapping; returns plastic work [J]. No-op without a yield stress.

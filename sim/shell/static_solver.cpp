@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "sim/core/check.h"
+#include "sim/shell/fd_stiffness.h"
 
 namespace shellmpm {
 namespace {
@@ -50,82 +51,19 @@ struct Problem {
   }
 };
 
-/// Greedy distance-2 colouring: points sharing a colour have disjoint coupling sets, so
-/// one force evaluation with all of them perturbed separates their stiffness columns.
-std::vector<std::vector<int>> colour_points(const std::vector<std::vector<int>>& coupling,
-                                            const std::vector<char>& movable) {
-  const int n = static_cast<int>(coupling.size());
-  std::vector<int> colour(n, -1), stamp;
-  std::vector<std::vector<int>> groups;
-  for (int j = 0; j < n; ++j) {
-    if (!movable[j]) continue;
-    stamp.assign(groups.size() + 1, -1);
-    for (int i : coupling[j])
-      for (int k : coupling[i])
-        if (colour[k] >= 0) stamp[colour[k]] = j;
-    int c = 0;
-    while (stamp[c] == j) ++c;
-    if (c == static_cast<int>(groups.size())) groups.emplace_back();
-    colour[j] = c;
-    groups[c].push_back(j);
-  }
-  return groups;
-}
-
-/// Tangent stiffness K = -df/dq at q (forward differences, symmetrised).
-SpMat fd_stiffness(Problem& pb, const VecX& q, const std::vector<std::vector<int>>& coupling,
-                   const std::vector<std::vector<int>>& groups, double eps) {
-  std::vector<Eigen::Triplet<double>> trip;
+/// Tangent stiffness K = -df/dq at q (fd_stiffness.h), counting the evaluations.
+SpMat problem_stiffness(Problem& pb, const VecX& q, const std::vector<std::vector<int>>& coupling,
+                        const std::vector<std::vector<int>>& groups, double eps) {
   std::vector<Vec3d> base;
   pb.set(q, base);
   pb.eval(base);
   const std::vector<Vec3d> f0 = pb.f;
-  std::vector<Vec3d> p;
-  for (const std::vector<int>& group : groups)
-    for (int a = 0; a < 3; ++a) {
-      p = base;
-      bool any = false;
-      for (int j : group)
-        if (pb.dof_of[3 * j + a] >= 0) {
-          p[j][a] += eps;
-          any = true;
-        }
-      if (!any) continue;
-      pb.eval(p);
-      for (int j : group) {
-        const int col = pb.dof_of[3 * j + a];
-        if (col < 0) continue;
-        for (int i : coupling[j])
-          for (int b = 0; b < 3; ++b) {
-            const int row = pb.dof_of[3 * i + b];
-            if (row >= 0) trip.emplace_back(row, col, -(pb.f[i][b] - f0[i][b]) / eps);
-          }
-      }
-    }
-  const int n = static_cast<int>(pb.dofs.size());
-  SpMat K(n, n);
-  K.setFromTriplets(trip.begin(), trip.end());
-  const SpMat Kt = K.transpose();
-  return 0.5 * (K + Kt);
-}
-
-/// Factorises K + mu diag(|K_ii| + mean |K_ii|), raising mu from 0 until the factor is
-/// positive definite (a descent direction for any gradient).
-std::unique_ptr<Eigen::SimplicialLDLT<SpMat>> factorise(const SpMat& K) {
-  const int n = static_cast<int>(K.rows());
-  VecX diag = K.diagonal().cwiseAbs();
-  const double mean = diag.sum() / std::max(n, 1);
-  SHELLMPM_CHECK(std::isfinite(mean), << "non-finite stiffness (forces not finite?)");
-  auto solver = std::make_unique<Eigen::SimplicialLDLT<SpMat>>();
-  solver->analyzePattern(K);
-  for (double mu = 0;; mu = (mu == 0) ? 1e-8 : 10 * mu) {
-    SHELLMPM_CHECK(mu < 1e8, << "stiffness could not be made positive definite");
-    SpMat A = K;
-    if (mu > 0)
-      for (int i = 0; i < n; ++i) A.coeffRef(i, i) += mu * (diag[i] + mean);
-    solver->factorize(A);
-    if (solver->info() == Eigen::Success && (solver->vectorD().array() > 0).all()) return solver;
-  }
+  const PointForceFn eval = [&pb](const std::vector<Vec3d>& p, std::vector<Vec3d>& f) {
+    pb.eval(p);
+    f = pb.f;
+  };
+  return fd_stiffness(eval, base, f0, pb.dof_of, static_cast<int>(pb.dofs.size()), coupling, groups,
+                      eps);
 }
 
 /// Numbers the free (point, component) pairs of free_mask into pb.dofs / pb.dof_of;
@@ -282,7 +220,7 @@ StaticSolveResult solve_static(std::vector<Vec3d>& x, const std::vector<std::uin
       break;
     }
     if (newton && (!H0 || since_refresh >= opt.hessian_every)) {
-      H0 = factorise(fd_stiffness(pb, q, opt.coupling, groups, eps));
+      H0 = factorise_positive(problem_stiffness(pb, q, opt.coupling, groups, eps));
       ++res.hessian_evaluations;
       hist.clear();
       since_refresh = 0;

@@ -9,6 +9,24 @@
 
 namespace shellmpm {
 
+/// What the implicit integrator did over a frame (shot.integrator implicit).
+struct ImplicitStats {
+  int steps = 0;              ///< implicit steps taken
+  int solves = 0;             ///< Newton solves (one per shell per attempt)
+  int newton_iterations = 0;  ///< summed over the solves
+  int max_newton_iterations = 0;
+  int cg_iterations = 0;    ///< summed over the solves
+  double max_residual = 0;  ///< largest final residual of a solve [m/s]
+  int retries = 0;          ///< steps taken again at half the step (a solve did not converge)
+  void add(int newton, int cg, double residual) {
+    ++solves;
+    newton_iterations += newton;
+    max_newton_iterations = newton > max_newton_iterations ? newton : max_newton_iterations;
+    cg_iterations += cg;
+    max_residual = residual > max_residual ? residual : max_residual;
+  }
+};
+
 struct FrameStats {
   int frame = 0;
   double time = 0;  ///< simulation time at the end of the frame [s]
@@ -40,6 +58,8 @@ struct FrameStats {
   std::size_t guard_impulses = 0;    ///< pair impulses applied, summed over the steps
   std::size_t guard_zoned = 0;       ///< points moved in impact zones, summed
   std::size_t guard_unresolved = 0;  ///< pairs left closing at a step's end, summed
+  bool implicit = false;             ///< shot.integrator implicit: `implicit_stats` is filled
+  ImplicitStats implicit_stats;
   /// What the integrity monitor found (crossings, collider penetration, non-finite).
   IntegrityReport integrity;
   /// Wall-clock seconds per stage, in stage order (not deterministic, unlike the rest).

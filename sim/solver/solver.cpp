@@ -100,7 +100,9 @@ double Solver::stable_dt() const {
 
 double Solver::stable_dt(double* vmax_out) const {
   const ShotSettings& s = c_.scene.shot;
-  double dt = std::min(s.dt_max, c_.shell_dt);
+  // Implicit: no wave-speed bound, only motion (cfl dx / max speed) and dt_max.
+  const bool implicit = s.integrator == Integrator::Implicit;
+  double dt = implicit ? s.dt_max : std::min(s.dt_max, c_.shell_dt);
   const std::size_t n = c_.particles.size();
   double vmax = 0, cmax = 0;
   if (n > 0) {
@@ -139,10 +141,19 @@ double Solver::stable_dt(double* vmax_out) const {
       if (!std::isfinite(sp)) return sp;  // diverged
       vmax = std::max(vmax, sp);
     }
+  if (implicit)
+    for (std::size_t i = 0; i < c_.shells.size(); ++i) {
+      if (c_.contacts[i]) continue;
+      for (const Vec3& v : c_.shells[i]->v) {
+        const double sp = static_cast<double>(v.norm());
+        if (!std::isfinite(sp)) return sp;  // diverged
+        vmax = std::max(vmax, sp);
+      }
+    }
   for (const Collider& c : c_.colliders) vmax = std::max(vmax, c.max_speed(c_.time));
   if (vmax_out) *vmax_out = vmax;
   if (vmax > 0) dt = std::min(dt, s.cfl * s.dx / vmax);
-  if (cmax > 0) dt = std::min(dt, s.cfl * s.dx / cmax);
+  if (cmax > 0 && !implicit) dt = std::min(dt, s.cfl * s.dx / cmax);
   return dt;
 }
 
@@ -177,6 +188,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   const auto wall0 = clock::now();
   for (Slot& st : stages_) st.seconds = 0;
   c_.guard_frame = ShellGuardStats{};
+  c_.implicit_frame = ImplicitStats{};
   FrameStats fs;
   fs.dt_min = std::numeric_limits<double>::infinity();
   double dt_seconds = 0, integrity_seconds = 0;
@@ -201,7 +213,10 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
       st.stage->run(c_);
       st.seconds += std::chrono::duration<double>(clock::now() - t0).count();
     }
-    c_.time = (steps == 1.0) ? t_end : c_.time + dt;
+    // An implicit stage may have taken a shorter step than asked (a retry at half the step).
+    const bool shortened = c_.dt < dt;
+    dt = c_.dt;
+    c_.time = (steps == 1.0 && !shortened) ? t_end : c_.time + dt;
     fs.substeps++;
     fs.dt_min = std::min(fs.dt_min, dt);
     fs.dt_max = std::max(fs.dt_max, dt);
@@ -225,6 +240,8 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   const double reorder_seconds = std::chrono::duration<double>(clock::now() - r0).count();
   fs.time = c_.time;
   measure(fs);
+  fs.implicit = c_.scene.shot.integrator == Integrator::Implicit;
+  fs.implicit_stats = c_.implicit_frame;
   for (const Slot& st : stages_)
     fs.stage_seconds.emplace_back(std::string(st.stage->name()), st.seconds);
   if (!stages_.empty()) {

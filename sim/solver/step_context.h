@@ -18,6 +18,7 @@
 #include "sim/mpm/transfer.h"
 #include "sim/scene/scene.h"
 #include "sim/shell/shell_object.h"
+#include "sim/solver/frame_stats.h"
 #include "sim/solver/source_sampler.h"
 
 namespace shellmpm {
@@ -79,6 +80,8 @@ struct StepContext {
   /// shell_guard's counts over the frame so far (the solver zeroes it at a frame's start):
   /// pairs and sweeps are maxima over the steps, impulses, zoned and unresolved sums.
   ShellGuardStats guard_frame;
+  /// The implicit stages' counts over the frame so far (zeroed at a frame's start).
+  ImplicitStats implicit_frame;
   double friction_work = 0;  ///< [J]
   double plastic_work = 0;   ///< [J]
 

@@ -11,6 +11,7 @@
 #include "sim/solver/stages/friction.h"
 #include "sim/solver/stages/g2p.h"
 #include "sim/solver/stages/grid_update.h"
+#include "sim/solver/stages/implicit_shells.h"
 #include "sim/solver/stages/p2g.h"
 #include "sim/solver/stages/shell_forces.h"
 #include "sim/solver/stages/shell_guard.h"
@@ -38,6 +39,7 @@ const std::vector<Entry>& registry() {
   static const std::vector<Entry> table = {
       entry<ShellForcesStage>(),
       entry<ShellUpdateStage>(),
+      entry<ImplicitShellsStage>(),
       entry<ContactForcesStage>(),
       entry<BinStage>(),
       entry<P2gStage>(),

@@ -5,7 +5,8 @@
 namespace shellmpm {
 
 bool ShellForcesStage::needed(const Scene& s) {
-  return !s.shells.empty();
+  // Implicit: the shells without contact take their forces inside implicit_shells.
+  return s.shot.integrator == Integrator::Implicit ? any_contact_shell(s) : !s.shells.empty();
 }
 
 void ShellForcesStage::run(StepContext& c) {
@@ -13,6 +14,7 @@ void ShellForcesStage::run(StepContext& c) {
   for (std::size_t i = 0; i < c.shells.size(); ++i) {
     ShellObject& sh = *c.shells[i];
     if (!c.contacts[i]) {
+      if (c.scene.shot.integrator == Integrator::Implicit) continue;
       sh.forces(c.scene.shot.gravity, c.shell_forces[i], c.opt.serial);
       continue;
     }

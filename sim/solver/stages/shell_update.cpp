@@ -5,7 +5,7 @@
 namespace shellmpm {
 
 bool ShellUpdateStage::needed(const Scene& s) {
-  return any_direct_shell(s);
+  return s.shot.integrator == Integrator::Explicit && any_direct_shell(s);
 }
 
 void ShellUpdateStage::run(StepContext& c) {

@@ -1,0 +1,47 @@
+// Backward Euler for a shell without contact (its control points are the unknowns; no
+// grid). One step from t to t + dt minimises over the control-point velocities u
+//   E(u) = sum_j m_j (|u_j - v_j^n|^2 + dt c |u_j|^2) / 2 - dt f_ext . u
+//          + Psi_KL(x^n + dt u) + dt beta u . K(x^n) u / 2
+// (c: mass damping, beta: Rayleigh stiffness damping with K at the step's start, f_ext:
+// gravity, pressure and point loads at x^n), whose stationarity is
+//   m (u - v^n) = dt (f_KL(x^n + dt u) + f_ext - c m u - beta K u),
+// the implicit counterpart of ShellObject::integrate. Pinned components are constraints
+// (their velocity takes them to the pin pose at t + dt), as are points without mass.
+// Denting is applied after the step by the denting stage, as in the explicit path.
+//
+// The Kirchhoff-Love energy is evaluated in double (ShellObject::double_kl); Hessian
+// products are central differences of the gradient (newton.h). Preconditioner: the
+// tangent M (1 + dt c) + (dt^2 + dt beta) K assembled by finite differences of the forces
+// (fd_stiffness.h) at the start of the step and factorised (`factorised`, CG then takes a
+// few iterations per Newton step), or its 3x3 diagonal blocks (`block_jacobi`, no
+// factorisation; many more CG iterations on stiff sheets).
+#pragma once
+#include <memory>
+#include <vector>
+
+#include "sim/implicit/newton.h"
+#include "sim/shell/shell_object.h"
+
+namespace shellmpm {
+
+class ShellImplicitStep {
+ public:
+  explicit ShellImplicitStep(const ShellObject& sh);
+  ~ShellImplicitStep();
+
+  /// One step of sh from t to t + dt. On convergence writes sh.x and sh.v; otherwise
+  /// leaves sh as it was. The report says which.
+  NewtonReport step(ShellObject& sh, const Vec3d& gravity, double t, double dt,
+                    const NewtonOptions& opt, ImplicitPreconditioner pre, bool serial);
+  /// The objective of that step (for tests), and in u0 its starting point (v^n, with
+  /// the pinned components at their pin velocity).
+  std::unique_ptr<ImplicitObjective> objective(const ShellObject& sh, const Vec3d& gravity,
+                                               double t, double dt, ImplicitPreconditioner pre,
+                                               bool serial, VecXd& u0);
+
+ private:
+  std::vector<std::vector<int>> coupling_;  // before kl_: the constructor fills both
+  std::unique_ptr<KirchhoffLoveShellT<double>> kl_;
+};
+
+}  // namespace shellmpm

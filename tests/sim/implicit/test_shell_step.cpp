@@ -1,0 +1,239 @@
+// Backward Euler for shells without contact (sim/implicit/shell_step.h, the
+// implicit_shells stage): the objective's gradient, large steps against the static
+// solution, small steps against the explicit integrator, momentum and energy.
+#include <catch2/catch.hpp>
+#include <cmath>
+
+#include "sim/implicit/shell_step.h"
+#include "sim/solver/solver.h"
+#include "tests/support/shell_fixtures.h"
+
+using namespace shellmpm;
+
+namespace {
+
+/// The cantilevered strip of scenes/study/cantilever_gravity.yaml: L = 0.2 m, b = 0.05 m,
+/// t = 2 mm, E = 1e9 Pa, nu = 0, clamped over the rows x <= h (n = 16).
+Scene cantilever_scene() {
+  Scene s = test::contact_test_scene(0.02);
+  s.shot.fps = 24;
+  ShellMaterialDesc m;
+  m.name = "strip";
+  m.youngs_modulus = 1e9;
+  m.poisson_ratio = 0.0;
+  m.density = 1000;
+  m.thickness = 0.002;
+  s.shell_materials.push_back(m);
+  ShellDesc sh;
+  sh.name = "strip";
+  sh.contact = ShellDesc::Contact::Off;
+  sh.kind = ShellDesc::Kind::Sheet;
+  sh.size[0] = 0.2125;
+  sh.size[1] = 0.05;
+  sh.resolution[0] = 17;
+  sh.resolution[1] = 4;
+  sh.translate = Vec3d(0.09375, 0, 0);
+  PinDesc clamp;
+  clamp.has_box = true;
+  clamp.box_min = Vec3d(-1, -1, -1);
+  clamp.box_max = Vec3d(0.0125001, 1, 1);
+  sh.pins.push_back(clamp);
+  s.shells.push_back(sh);
+  return s;
+}
+
+/// A 0.3 m cloth held at two corners (a swing under gravity).
+Scene cloth_scene() {
+  Scene s = test::contact_test_scene(0.02);
+  s.shot.fps = 24;
+  s.shell_materials.push_back(test::cloth_material());
+  ShellDesc sh;
+  sh.name = "cloth";
+  sh.contact = ShellDesc::Contact::Off;
+  sh.kind = ShellDesc::Kind::Sheet;
+  sh.size[0] = 0.3;
+  sh.size[1] = 0.3;
+  sh.resolution[0] = 8;
+  sh.resolution[1] = 8;
+  PinDesc corners;
+  corners.indices = {0, 8};  // the two corners of the first row
+  sh.pins.push_back(corners);
+  s.shells.push_back(sh);
+  return s;
+}
+
+/// Largest downward deflection over the control points [m].
+double max_sag(const ShellObject& sh) {
+  double w = 0;
+  for (std::size_t i = 0; i < sh.size(); ++i)
+    w = std::max(w, sh.rest[i].y() - static_cast<double>(sh.x[i].y()));
+  return w;
+}
+
+/// Kinetic + elastic + gravitational potential energy [J], the elastic part in double (the
+/// float kernel's rounding, about 1e-8 J on the stiff strip, would hide the dissipation).
+double total_energy(const ShellObject& sh, const Vec3d& g) {
+  std::vector<Vec3d> x(sh.size());
+  for (std::size_t i = 0; i < sh.size(); ++i) x[i] = sh.x[i].cast<double>();
+  double e = sh.kinetic_energy() + sh.double_kl()->energy(x.data(), nullptr).total;
+  for (std::size_t i = 0; i < sh.size(); ++i) e -= static_cast<double>(sh.mass[i]) * g.dot(x[i]);
+  return e;
+}
+
+}  // namespace
+
+TEST_CASE("implicit shell: the objective's gradient matches finite differences", "[implicit]") {
+  Scene s = cantilever_scene();
+  s.shell_materials[0].damping = 2.0;
+  s.shell_materials[0].stiffness_damping = 1e-4;
+  Solver solver(s);
+  ShellObject& sh = *solver.shells()[0];
+  // A bent state with a velocity field, so every term is active.
+  for (std::size_t i = 0; i < sh.size(); ++i) {
+    if (sh.pin_mask[i]) continue;
+    const double x = static_cast<double>(sh.x[i].x());
+    sh.x[i].y() -= static_cast<Real>(0.05 * x * x);
+    sh.v[i] = Vec3(Real(0.1 * std::sin(20 * x)), Real(-0.3 * x), Real(0.05));
+  }
+  ShellImplicitStep step(sh);
+  VecXd u0;
+  const auto obj = step.objective(sh, s.shot.gravity, 0.0, 1.0 / 24,
+                                  ImplicitPreconditioner::Factorised, true, u0);
+  VecXd u = u0, d(u0.size()), g;
+  for (Eigen::Index k = 0; k < u.size(); ++k) d[k] = std::cos(0.7 * k);
+  obj->project(d);
+  u += 0.01 * d;
+  obj->gradient(u, g);
+  const double slope = g.dot(d);
+  double prev_err = 1e300;
+  for (const double eps : {1e-3, 1e-4, 1e-5}) {
+    const double fd = (obj->energy(u + eps * d) - obj->energy(u - eps * d)) / (2 * eps);
+    const double err = std::abs(fd - slope);
+    INFO("eps " << eps << " fd " << fd << " analytic " << slope);
+    CHECK(err < 1e-4 * std::abs(slope) + 1e-12);
+    CHECK(err <= prev_err);
+    prev_err = err;
+  }
+}
+
+TEST_CASE("implicit shell: a cantilever stepped at 1/24 s settles to the static deflection",
+          "[implicit]") {
+  Scene s = cantilever_scene();
+  s.shot.integrator = Integrator::Implicit;
+  s.shot.dt_max = 1.0 / 24;
+  s.shot.implicit_tolerance = 1e-6;
+  Solver solver(s);
+  int steps = 0, retries = 0;
+  for (int f = 1; f <= 24; ++f) {
+    const FrameStats fs = solver.advance_to(f / 24.0);
+    steps += fs.substeps;
+    retries += fs.implicit_stats.retries;
+    CHECK(fs.implicit_stats.steps == fs.substeps);
+  }
+  CHECK(steps == 24);  // one step per frame: motion, not stiffness, bounds the step
+  CHECK(retries == 0);
+  const double implicit_sag = max_sag(*solver.shells()[0]);
+  Solver reference(s);
+  const StaticSolveResult r = reference.shells()[0]->settle(s.shot.gravity, 0.0, 1e-9, 2000, true);
+  REQUIRE(r.converged);
+  const double static_sag = max_sag(*reference.shells()[0]);
+  INFO("implicit " << implicit_sag << " m, static " << static_sag << " m");
+  CHECK(static_sag > 5e-3);  // 5.9 mm from beam theory
+  CHECK(implicit_sag == Approx(static_sag).epsilon(0.01));
+}
+
+TEST_CASE("implicit shell: stable at a step where the explicit integrator diverges", "[implicit]") {
+  Scene s = cantilever_scene();
+  const double dt = 1.0 / 24;
+  {
+    // Explicit at the same step: the energy explodes.
+    Solver ex(s);
+    ShellObject& sh = *ex.shells()[0];
+    std::vector<Vec3> f;
+    const double e0 = total_energy(sh, s.shot.gravity);
+    for (int k = 0; k < 5; ++k) {
+      sh.forces(s.shot.gravity, f, true);
+      sh.integrate(f, k * dt, dt, true);
+    }
+    const double e1 = total_energy(sh, s.shot.gravity);
+    CHECK(!(std::abs(e1) < 1e3 * std::abs(e0) + 1.0));
+  }
+  s.shot.integrator = Integrator::Implicit;
+  s.shot.dt_max = dt;
+  s.shot.implicit_tolerance = 1e-8;  // a loose solve adds its own error to the energy
+  Solver im(s);
+  ShellObject& sh = *im.shells()[0];
+  double e_prev = total_energy(sh, s.shot.gravity);
+  // Backward Euler dissipates; it never adds energy (up to the float rounding of the
+  // stored positions, far below this margin: 1e-6 of the static energy).
+  const double margin = 2e-10;
+  double e_first = 0;
+  for (int f = 1; f <= 12; ++f) {
+    im.advance_to(f * dt);
+    const double e = total_energy(sh, s.shot.gravity);
+    CHECK(std::isfinite(e));
+    CHECK(e <= e_prev + margin);
+    if (f == 1) e_first = e;
+    e_prev = e;
+  }
+  CHECK(e_first < -1e-5);  // it sagged: gravity's work went into bending and was damped
+}
+
+TEST_CASE("implicit shell: at small steps it follows the explicit cloth swing", "[implicit]") {
+  Scene s = cloth_scene();
+  Solver ex(s);
+  const double t_end = 0.25;
+  ex.advance_to(t_end);
+  s.shot.integrator = Integrator::Implicit;
+  s.shot.dt_max = 1e-3;
+  s.shot.implicit_tolerance = 1e-6;
+  Solver im(s);
+  im.advance_to(t_end);
+  const ShellObject& a = *ex.shells()[0];
+  const ShellObject& b = *im.shells()[0];
+  double diff = 0, moved = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    diff = std::max(diff, static_cast<double>((a.x[i] - b.x[i]).norm()));
+    moved = std::max(moved, (a.x[i].cast<double>() - a.rest[i]).norm());
+  }
+  INFO("largest difference " << diff << " m of a largest displacement " << moved << " m");
+  CHECK(moved > 0.05);
+  CHECK(diff < 0.03 * moved);
+}
+
+TEST_CASE("implicit shell: momentum is conserved and energy does not grow without loads",
+          "[implicit]") {
+  Scene s = cloth_scene();
+  s.shells[0].pins.clear();
+  s.shot.gravity = Vec3d::Zero();
+  s.shot.integrator = Integrator::Implicit;
+  s.shot.dt_max = 1.0 / 24;
+  s.shot.implicit_tolerance = 1e-9;
+  Solver solver(s);
+  ShellObject& sh = *solver.shells()[0];
+  // Translation, spin and a stretch: internal forces change the shape, not the momentum.
+  for (std::size_t i = 0; i < sh.size(); ++i) {
+    const Vec3d r = sh.x[i].cast<double>();
+    const Vec3d v = Vec3d(0.2, 0.1, -0.05) + Vec3d(0, 2.0, 0).cross(r) + 0.5 * Vec3d(r.x(), 0, 0);
+    sh.v[i] = v.cast<Real>();
+  }
+  auto momentum = [&] {
+    Vec3d p = Vec3d::Zero();
+    for (std::size_t i = 0; i < sh.size(); ++i)
+      p += static_cast<double>(sh.mass[i]) * sh.v[i].cast<double>();
+    return p;
+  };
+  const Vec3d p0 = momentum();
+  double e_prev = total_energy(sh, s.shot.gravity);
+  double mass = 0;
+  for (Real m : sh.mass) mass += static_cast<double>(m);
+  for (int f = 1; f <= 6; ++f) {
+    solver.advance_to(f / 24.0);
+    const Vec3d p = momentum();
+    INFO("frame " << f);
+    CHECK((p - p0).norm() < 1e-5 * mass);
+    const double e = total_energy(sh, s.shot.gravity);
+    CHECK(e <= e_prev * (1 + 1e-6) + 1e-12);
+    e_prev = e;
+  }
+}
