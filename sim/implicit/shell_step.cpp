@@ -23,6 +23,7 @@ class ShellObjective final : public ImplicitObjective {
     std::vector<Vec3d> target;
     sh.pin_targets(t, dt, held, target);
     u0_.resize(3 * n_);
+    v0_.resize(3 * n_);
     m_.resize(3 * n_);
     fixed_.assign(3 * n_, 0);
     for (std::size_t i = 0; i < n_; ++i)
@@ -30,6 +31,7 @@ class ShellObjective final : public ImplicitObjective {
         const std::size_t k = 3 * i + a;
         m_[k] = static_cast<double>(sh.mass[i]);
         u0_[k] = static_cast<double>(sh.v[i][a]);
+        v0_[k] = u0_[k];
         if (held[i] & (1u << a)) {
           fixed_[k] = 1;
           u0_[k] = (target[i][a] - x0_[i][a]) / dt;
@@ -37,9 +39,6 @@ class ShellObjective final : public ImplicitObjective {
           fixed_[k] = 1;
         }
       }
-    v0_ = u0_;
-    for (std::size_t k = 0; k < 3 * n_; ++k)
-      if (!fixed_[k]) v0_[k] = static_cast<double>(sh.v[k / 3][static_cast<int>(k % 3)]);
     damping_ = sh.material().damping;
     beta_ = sh.material().stiffness_damping;
     Eigen::AlignedBox<double, 3> box;
