@@ -19,6 +19,7 @@
 #include "bench/bench_args.h"
 #include "bench/timed_advance.h"
 #include "sim/core/parallel.h"
+#include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;
 
@@ -49,20 +50,7 @@ Case aluminium_strip() {
   m.density = 2700;
   m.thickness = 1e-3;
   c.scene.shell_materials.push_back(m);
-  ShellDesc sh;
-  sh.name = "strip";
-  sh.contact = ShellDesc::Contact::Off;
-  sh.kind = ShellDesc::Kind::Sheet;
-  sh.size[0] = 0.2125;  // L = 0.2 m plus one row behind the clamp
-  sh.size[1] = 0.05;
-  sh.resolution[0] = 17;
-  sh.resolution[1] = 4;
-  sh.translate = Vec3d(0.09375, 0, 0);
-  PinDesc clamp;
-  clamp.has_box = true;
-  clamp.box_min = Vec3d(-1, -1, -1);
-  clamp.box_max = Vec3d(0.0125001, 1, 1);
-  sh.pins.push_back(clamp);
+  const ShellDesc sh = shellmpm::test::clamped_strip("strip");
   c.scene.shells.push_back(sh);
   return c;
 }

@@ -1,5 +1,7 @@
 // Shared shell test fixtures.
 #pragma once
+#include <string>
+
 #include "sim/scene/scene.h"
 
 namespace shellmpm::test {
@@ -13,6 +15,28 @@ inline ShellMaterialDesc cloth_material() {
   m.density = 300;
   m.thickness = 1e-3;
   return m;
+}
+
+/// The clamped strip of scenes/study/cantilever_gravity.yaml (n = 16, contact off): free
+/// length L = 0.2 m, width 0.05 m, one control row behind the clamp, which pins the rows
+/// x <= h = L / 16 (the limit surface is then clamped at x = 0).
+inline ShellDesc clamped_strip(const std::string& name) {
+  ShellDesc sh;
+  sh.name = name;
+  sh.material = 0;  // the scene's first shell material
+  sh.contact = ShellDesc::Contact::Off;
+  sh.kind = ShellDesc::Kind::Sheet;
+  sh.size[0] = 0.2125;
+  sh.size[1] = 0.05;
+  sh.resolution[0] = 17;
+  sh.resolution[1] = 4;
+  sh.translate = Vec3d(0.09375, 0, 0);
+  PinDesc clamp;
+  clamp.has_box = true;
+  clamp.box_min = Vec3d(-1, -1, -1);
+  clamp.box_max = Vec3d(0.0125001, 1, 1);
+  sh.pins.push_back(clamp);
+  return sh;
 }
 
 /// A scene for contact tests: grid spacing dx, CFL 0.5, 48 fps, the domain [-1, 1]^3.

@@ -24,20 +24,7 @@ Scene cantilever_scene() {
   m.density = 1000;
   m.thickness = 0.002;
   s.shell_materials.push_back(m);
-  ShellDesc sh;
-  sh.name = "strip";
-  sh.contact = ShellDesc::Contact::Off;
-  sh.kind = ShellDesc::Kind::Sheet;
-  sh.size[0] = 0.2125;
-  sh.size[1] = 0.05;
-  sh.resolution[0] = 17;
-  sh.resolution[1] = 4;
-  sh.translate = Vec3d(0.09375, 0, 0);
-  PinDesc clamp;
-  clamp.has_box = true;
-  clamp.box_min = Vec3d(-1, -1, -1);
-  clamp.box_max = Vec3d(0.0125001, 1, 1);
-  sh.pins.push_back(clamp);
+  const ShellDesc sh = test::clamped_strip("strip");
   s.shells.push_back(sh);
   return s;
 }
@@ -59,6 +46,14 @@ Scene cloth_scene() {
   corners.indices = {0, 8};  // the two corners of the first row
   sh.pins.push_back(corners);
   s.shells.push_back(sh);
+  return s;
+}
+
+/// s with the implicit integrator, steps of at most dt_max and the Newton tolerance tol.
+Scene implicit(Scene s, double dt_max, double tol = 1e-4) {
+  s.shot.integrator = Integrator::Implicit;
+  s.shot.dt_max = dt_max;
+  s.shot.implicit_tolerance = tol;
   return s;
 }
 
@@ -119,9 +114,7 @@ TEST_CASE("implicit shell: the objective's gradient matches finite differences",
 TEST_CASE("implicit shell: a cantilever stepped at 1/24 s settles to the static deflection",
           "[implicit]") {
   Scene s = cantilever_scene();
-  s.shot.integrator = Integrator::Implicit;
-  s.shot.dt_max = 1.0 / 24;
-  s.shot.implicit_tolerance = 1e-6;
+  s = implicit(s, 1.0 / 24, 1e-6);
   Solver solver(s);
   int steps = 0, retries = 0;
   for (int f = 1; f <= 24; ++f) {
@@ -158,9 +151,7 @@ TEST_CASE("implicit shell: stable at a step where the explicit integrator diverg
     const double e1 = total_energy(sh, s.shot.gravity);
     CHECK(!(std::abs(e1) < 1e3 * std::abs(e0) + 1.0));
   }
-  s.shot.integrator = Integrator::Implicit;
-  s.shot.dt_max = dt;
-  s.shot.implicit_tolerance = 1e-8;  // a loose solve adds its own error to the energy
+  s = implicit(s, dt, 1e-8);  // a loose solve adds its own error to the energy
   Solver im(s);
   ShellObject& sh = *im.shells()[0];
   double e_prev = total_energy(sh, s.shot.gravity);
@@ -184,9 +175,7 @@ TEST_CASE("implicit shell: at small steps it follows the explicit cloth swing", 
   Solver ex(s);
   const double t_end = 0.25;
   ex.advance_to(t_end);
-  s.shot.integrator = Integrator::Implicit;
-  s.shot.dt_max = 1e-3;
-  s.shot.implicit_tolerance = 1e-6;
+  s = implicit(s, 1e-3, 1e-6);
   Solver im(s);
   im.advance_to(t_end);
   const ShellObject& a = *ex.shells()[0];
@@ -206,9 +195,7 @@ TEST_CASE("implicit shell: momentum is conserved and energy does not grow withou
   Scene s = cloth_scene();
   s.shells[0].pins.clear();
   s.shot.gravity = Vec3d::Zero();
-  s.shot.integrator = Integrator::Implicit;
-  s.shot.dt_max = 1.0 / 24;
-  s.shot.implicit_tolerance = 1e-9;
+  s = implicit(s, 1.0 / 24, 1e-9);
   Solver solver(s);
   ShellObject& sh = *solver.shells()[0];
   // Translation, spin and a stretch: internal forces change the shape, not the momentum.
@@ -240,9 +227,7 @@ TEST_CASE("implicit shell: momentum is conserved and energy does not grow withou
 
 TEST_CASE("implicit shell: the same bits with and without threads, and from a restored state",
           "[implicit]") {
-  Scene s = cloth_scene();
-  s.shot.integrator = Integrator::Implicit;
-  s.shot.dt_max = 1.0 / 96;
+  const Scene s = implicit(cloth_scene(), 1.0 / 96);
   SolverOptions serial;
   serial.serial = true;
   Solver a(s, serial), b(s);
