@@ -11,7 +11,7 @@ namespace shellmpm {
 
 /// What the implicit integrator did over a frame (shot.integrator implicit).
 struct ImplicitStats {
-  int steps = 0;              ///< implicit steps taken
+  int steps = 0;              ///< implicit steps taken (the frame's substeps)
   int solves = 0;             ///< Newton solves (one per shell per attempt)
   int newton_iterations = 0;  ///< summed over the solves
   int max_newton_iterations = 0;

@@ -242,6 +242,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   measure(fs);
   fs.implicit = c_.scene.shot.integrator == Integrator::Implicit;
   fs.implicit_stats = c_.implicit_frame;
+  if (fs.implicit) fs.implicit_stats.steps = fs.substeps;
   for (const Slot& st : stages_)
     fs.stage_seconds.emplace_back(std::string(st.stage->name()), st.seconds);
   if (!stages_.empty()) {

@@ -8,6 +8,8 @@ TransferParams StepContext::transfer_params() const {
   TransferParams tp;
   tp.dt = static_cast<Real>(dt);
   tp.mls = scene.shot.transfer == Transfer::Mls;
+  // Implicit: the stress enters the grid solve (implicit_grid), not P2G.
+  tp.stress = scene.shot.integrator == Integrator::Explicit;
   tp.serial = opt.serial;
   tp.models = &models;
   tp.densities = &densities;

@@ -46,5 +46,6 @@ TEST_CASE("CLI implicit: shells in contact are refused at shot.integrator", "[cl
   INFO(r.output);
   CHECK(r.code == 2);
   CHECK(r.output.find("shot.integrator") != std::string::npos);
-  CHECK(r.output.find("implicit steps shells without contact only") != std::string::npos);
+  CHECK(r.output.find("implicit steps bulk materials and shells without contact only") !=
+        std::string::npos);
 }

@@ -1121,5 +1121,6 @@ TEST_CASE("scene: shot.integrator implicit, its dt_max default and its scope", "
   // explicit.
   expect_error(head + shells +
                    "colliders:\n  - {shape: {type: plane, point: [0, -1, 0], normal: [0, 1, 0]}}\n",
-               5, "shot.integrator", {"implicit steps shells without contact only", "'s'"});
+               5, "shot.integrator",
+               {"implicit steps bulk materials and shells without contact only", "'s'"});
 }

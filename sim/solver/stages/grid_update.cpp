@@ -8,7 +8,7 @@
 namespace shellmpm {
 
 bool GridUpdateStage::needed(const Scene& s) {
-  return grid_needed(s);
+  return grid_needed(s) && s.shot.integrator == Integrator::Explicit;
 }
 
 void GridUpdateStage::run(StepContext& c) {

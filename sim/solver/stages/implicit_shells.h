@@ -1,8 +1,9 @@
 // Stage "implicit_shells": shells without contact, stepped by backward Euler
 // (sim/implicit/shell_step.h) with shot.integrator implicit. A step whose Newton solve
-// does not converge is taken again from the same state at half the step (every shell,
+// does not converge is taken again from the same state as two half steps (every shell,
 // so they stay in time together), down to shot.dt_min; the retries are counted in the
-// frame's statistics, and the step the stage took is left in StepContext::dt.
+// frame's statistics. The stage always covers the whole StepContext::dt (the grid's step,
+// which implicit_grid may have shortened before it).
 #pragma once
 #include <memory>
 #include <vector>
@@ -21,6 +22,8 @@ class ImplicitShellsStage final : public Stage {
   void run(StepContext& c) override;
 
  private:
+  /// Advances the shells without contact from t by dt (in halves where a solve fails).
+  void advance(StepContext& c, double t, double dt);
   std::vector<std::unique_ptr<ShellImplicitStep>> steps_;  // per shell; null: on the grid
 };
 

@@ -11,6 +11,7 @@
 #include "sim/solver/stages/friction.h"
 #include "sim/solver/stages/g2p.h"
 #include "sim/solver/stages/grid_update.h"
+#include "sim/solver/stages/implicit_grid.h"
 #include "sim/solver/stages/implicit_shells.h"
 #include "sim/solver/stages/p2g.h"
 #include "sim/solver/stages/shell_forces.h"
@@ -39,11 +40,12 @@ const std::vector<Entry>& registry() {
   static const std::vector<Entry> table = {
       entry<ShellForcesStage>(),
       entry<ShellUpdateStage>(),
-      entry<ImplicitShellsStage>(),
       entry<ContactForcesStage>(),
       entry<BinStage>(),
       entry<P2gStage>(),
       entry<GridUpdateStage>(),
+      entry<ImplicitGridStage>(),
+      entry<ImplicitShellsStage>(),
       entry<ContactGridStage>(),
       entry<CollidersStage>(),
       entry<G2pStage>(),

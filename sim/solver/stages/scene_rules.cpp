@@ -44,4 +44,12 @@ bool any_emitting_source(const Scene& s) {
   return false;
 }
 
+NewtonOptions newton_options(const ShotSettings& s) {
+  NewtonOptions o;
+  o.tolerance = s.implicit_tolerance;
+  o.max_iterations = s.newton_max_iterations;
+  o.max_cg_iterations = s.cg_max_iterations;
+  return o;
+}
+
 }  // namespace shellmpm

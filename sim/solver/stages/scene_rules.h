@@ -3,6 +3,7 @@
 #pragma once
 #include <cstddef>
 
+#include "sim/implicit/newton.h"
 #include "sim/scene/scene.h"
 
 namespace shellmpm {
@@ -22,5 +23,8 @@ bool any_plastic_material(const Scene& s);
 bool any_denting_shell(const Scene& s);
 /// Some source emits continuously.
 bool any_emitting_source(const Scene& s);
+
+/// The Newton settings shot.integrator implicit asks for.
+NewtonOptions newton_options(const ShotSettings& s);
 
 }  // namespace shellmpm

@@ -1,0 +1,280 @@
+#include "sim/implicit/grid_step.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+
+#include "sim/core/parallel.h"
+#include "sim/mpm/bspline.h"
+
+namespace shellmpm {
+namespace {
+
+using Pad = std::array<Vec3d, kPadNodes>;
+
+/// A stencil node: offsets from the weights' base, padded-buffer index, weight.
+struct StencilNodeD {
+  int i, j, k, pad;
+  double w;
+};
+
+class GridObjective final : public ImplicitObjective {
+ public:
+  GridObjective(const GridStepInput& in, double dt) : in_(in), grid_(*in.grid), dt_(dt) {
+    nb_ = grid_.num_grid_blocks();
+    const std::size_t nodes = nb_ * kBlockNodes;
+    m_.setZero(static_cast<Eigen::Index>(nodes));
+    vhat_.setZero(3 * m_.size());
+    fixed_.assign(3 * nodes, 1);
+    normal_.assign(nodes, Vec3d::Zero());
+    u0_.setZero(3 * m_.size());
+    vbuf_.resize(grid_.num_particle_blocks());
+    fbuf_.resize(grid_.num_particle_blocks());
+    for (std::size_t g = 0; g < nb_; ++g) {
+      const Vec3i corner = unpack_block(grid_.gblock_key[g]) * kBlockSize;
+      for (int n = 0; n < kBlockNodes; ++n) {
+        const GridNode& nd = grid_.gblock_nodes[g][n];
+        if (!(nd.m > 0)) continue;
+        const std::size_t i = g * kBlockNodes + n;
+        const double m = static_cast<double>(nd.m);
+        m_[i] = m;
+        for (int a = 0; a < 3; ++a) {
+          vhat_[3 * i + a] = static_cast<double>(nd.v[a]) / m;  // p / m, in double
+          fixed_[3 * i + a] = 0;
+        }
+        const Vec3i c(corner[0] + n / 16, corner[1] + (n / 4) % 4, corner[2] + n % 4);
+        constrain(i, c);
+      }
+    }
+    prepare_diagonal();
+  }
+
+  Eigen::Index size() const override { return vhat_.size(); }
+  const VecXd& initial() const { return u0_; }
+
+  double energy(const VecXd& u) override {
+    scatter(u);
+    double e = elastic(nullptr);
+    for (Eigen::Index i = 0; i < m_.size(); ++i) {
+      if (!(m_[i] > 0)) continue;
+      const Vec3d du = u.segment<3>(3 * i) - vhat_.segment<3>(3 * i);
+      e += m_[i] * (0.5 * du.squaredNorm() - dt_ * in_.gravity.dot(u.segment<3>(3 * i)));
+    }
+    return e;
+  }
+
+  void gradient(const VecXd& u, VecXd& g) override {
+    scatter(u);
+    elastic(&fbuf_);
+    g.setZero(size());
+    gather(fbuf_, g);
+    for (Eigen::Index i = 0; i < m_.size(); ++i) {
+      if (!(m_[i] > 0)) continue;
+      g.segment<3>(3 * i) +=
+          m_[i] * (u.segment<3>(3 * i) - vhat_.segment<3>(3 * i) - dt_ * in_.gravity);
+    }
+    project(g);
+  }
+
+  void apply_preconditioner(const VecXd& r, VecXd& z) const override { z = r.cwiseQuotient(diag_); }
+
+  void project(VecXd& d) const override {
+    for (Eigen::Index i = 0; i < m_.size(); ++i) {
+      const Vec3d& n = normal_[i];
+      if (n.squaredNorm() > 0) d.segment<3>(3 * i) -= n.dot(d.segment<3>(3 * i)) * n;
+      for (int a = 0; a < 3; ++a)
+        if (fixed_[3 * i + a]) d[3 * i + a] = 0;
+    }
+  }
+
+ private:
+  /// Walls and colliders on node i (grid coordinate c), from its predicted velocity; sets
+  /// u0_ for the node.
+  void constrain(std::size_t i, const Vec3i& c) {
+    Vec3d v = vhat_.segment<3>(3 * i) + dt_ * in_.gravity;
+    if (in_.colliders) {
+      const Vec3d x = grid_.node_position(c);
+      for (const Collider& col : *in_.colliders) {
+        if (col.phi(x) > 0) continue;
+        const Vec3d n = col.normal(x), vc = col.velocity(x);
+        const BoundaryKind kind = col.desc().boundary;
+        if (kind == BoundaryKind::Sticky) {
+          v = vc;
+          for (int a = 0; a < 3; ++a) fixed_[3 * i + a] = 1;
+        } else if (kind == BoundaryKind::Slip || (v - vc).dot(n) < 0) {
+          v -= (v - vc).dot(n) * n;  // the collider's normal velocity, free along it
+          normal_[i] = n;
+        }
+        break;
+      }
+    }
+    for (int a = 0; a < 3; ++a) {
+      const bool low = c[a] < in_.wall_cells && v[a] < 0;
+      const bool high = c[a] > in_.domain_cells[a] - in_.wall_cells && v[a] > 0;
+      if (low || high) {
+        v[a] = 0;
+        fixed_[3 * i + a] = 1;
+      }
+    }
+    u0_.segment<3>(3 * i) = v;
+  }
+
+  /// u into every particle block's padded buffer (vbuf_).
+  void scatter(const VecXd& u) {
+    parallel_for_each(
+        grid_.num_particle_blocks(), 4,
+        [&](std::size_t b) {
+          Pad& buf = vbuf_[b];
+          for (int o = 0; o < 8; ++o) {
+            const std::size_t g = static_cast<std::size_t>(grid_.pblock_nbr[b][o]);
+            const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
+            const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
+            for (int i = 0; i < ix1; ++i)
+              for (int j = 0; j < iy1; ++j)
+                for (int k = 0; k < iz1; ++k)
+                  buf[pad_node(i + ox, j + oy, k + oz)] =
+                      u.segment<3>(3 * (g * kBlockNodes + block_node(i, j, k)));
+          }
+        },
+        in_.serial);
+  }
+
+  /// Sums the particle blocks' buffers into per-node vectors (the grid's fixed order).
+  void gather(const std::vector<Pad>& bufs, VecXd& out) const {
+    parallel_for_each(
+        nb_, 4,
+        [&](std::size_t g) {
+          grid_.for_each_buffer_node(g, [&](int bn, std::size_t src, int pn) {
+            out.segment<3>(3 * (g * kBlockNodes + bn)) += bufs[src][pn];
+          });
+        },
+        in_.serial);
+  }
+
+  /// Calls f(q, W, corner) for the bulk particles of particle block b.
+  template <class F>
+  void each_particle(std::size_t b, F&& f) const {
+    const Vec3i corner = unpack_block(grid_.pblock_key[b]) * kBlockSize;
+    for (std::uint32_t s = grid_.pblock_start[b]; s < grid_.pblock_start[b + 1]; ++s) {
+      const std::uint32_t q = grid_.order[s];
+      f(q, QuadraticWeights(grid_.grid_coord(in_.particles->x[q])), corner);
+    }
+  }
+
+  /// The velocity-gradient weight of a stencil node [1/m]: grad w (APIC) or MLS's
+  /// 4 w (x_i - x_p) / dx^2.
+  Vec3d grad_weight(const QuadraticWeights& W, const StencilNodeD& s) const {
+    const double inv_dx = 1.0 / grid_.dx();
+    if (in_.mls) {
+      const Vec3d d(s.i - W.fx[0], s.j - W.fx[1], s.k - W.fx[2]);
+      return (4.0 * inv_dx * s.w) * d;
+    }
+    return inv_dx * Vec3d(W.dw[0][s.i] * W.w[1][s.j] * W.w[2][s.k],
+                          W.w[0][s.i] * W.dw[1][s.j] * W.w[2][s.k],
+                          W.w[0][s.i] * W.w[1][s.j] * W.dw[2][s.k]);
+  }
+
+  /// Elastic energy sum V psi(F(v)) at the velocities in vbuf_; with `forces`, also
+  /// dt V P(F) F^n^T grad w into each block's buffer.
+  double elastic(std::vector<Pad>* forces) {
+    const ParticleSet& p = *in_.particles;
+    const std::vector<double> parts = chunk_parts(
+        grid_.num_particle_blocks(), 1, in_.serial, 0.0,
+        [&](std::size_t b0, std::size_t b1, double& e) {
+          for (std::size_t b = b0; b < b1; ++b) {
+            if (forces) (*forces)[b].fill(Vec3d::Zero());
+            each_particle(b, [&](std::uint32_t q, const QuadraticWeights& W, const Vec3i& c) {
+              Mat3d gradv = Mat3d::Zero();
+              for_each_node(W, c, [&](const StencilNodeD& s) {
+                gradv += vbuf_[b][s.pad].cast<double>() * grad_weight(W, s).transpose();
+              });
+              const Mat3d Fn = p.F[q].cast<double>();
+              const Mat3d F = (Mat3d::Identity() + dt_ * gradv) * Fn;
+              const double pl = p.has_plastic() ? static_cast<double>(p.plastic[q]) : 0.0;
+              const ConstitutiveModelT<double>& model = (*in_.models)[p.material[q]];
+              const double V = static_cast<double>(p.volume[q]);
+              e += V * model.energy(F, pl);
+              if (!forces) return;
+              const Mat3d G = (dt_ * V) * model.first_piola(F, pl) * Fn.transpose();
+              for_each_node(W, c, [&](const StencilNodeD& s) {
+                (*forces)[b][s.pad] += G * grad_weight(W, s);
+              });
+            });
+          }
+        });
+    double e = 0;
+    for (double part : parts) e += part;
+    return e;
+  }
+
+  template <class F>
+  static void for_each_node(const QuadraticWeights& W, const Vec3i& corner, F&& f) {
+    const int lx = W.base[0] - corner[0], ly = W.base[1] - corner[1], lz = W.base[2] - corner[2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        for (int k = 0; k < 3; ++k)
+          f(StencilNodeD{i, j, k, pad_node(lx + i, ly + j, lz + k),
+                         static_cast<double>(W.w[0][i]) * W.w[1][j] * W.w[2][k]});
+  }
+
+  /// Jacobi diagonal m_i + dt^2 sum_p V_p c_p |grad w_ip|^2 (at F^n).
+  void prepare_diagonal() {
+    const ParticleSet& p = *in_.particles;
+    parallel_for_each(
+        grid_.num_particle_blocks(), 1,
+        [&](std::size_t b) {
+          fbuf_[b].fill(Vec3d::Zero());
+          each_particle(b, [&](std::uint32_t q, const QuadraticWeights& W, const Vec3i& c) {
+            const double pl = p.has_plastic() ? static_cast<double>(p.plastic[q]) : 0.0;
+            const double k = static_cast<double>(p.volume[q]) *
+                             (*in_.models)[p.material[q]].wave_modulus(p.F[q].cast<double>(), pl);
+            for_each_node(W, c, [&](const StencilNodeD& s) {
+              fbuf_[b][s.pad] += Vec3d::Constant(k * grad_weight(W, s).squaredNorm());
+            });
+          });
+        },
+        in_.serial);
+    diag_.setZero(size());
+    gather(fbuf_, diag_);
+    for (Eigen::Index i = 0; i < m_.size(); ++i)
+      for (int a = 0; a < 3; ++a) {
+        double& d = diag_[3 * i + a];
+        d = m_[i] > 0 ? m_[i] + dt_ * dt_ * d : 1.0;
+      }
+  }
+
+  const GridStepInput& in_;
+  SparseGrid& grid_;
+  double dt_;
+  std::size_t nb_ = 0;
+  VecXd m_, vhat_, u0_, diag_;
+  std::vector<char> fixed_;
+  std::vector<Vec3d> normal_;  // slip constraint normal per node (zero: none)
+  std::vector<Pad> vbuf_, fbuf_;
+};
+
+}  // namespace
+
+std::unique_ptr<ImplicitObjective> grid_objective(const GridStepInput& in, double dt, VecXd& u0) {
+  auto obj = std::make_unique<GridObjective>(in, dt);
+  u0 = obj->initial();
+  return obj;
+}
+
+NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const NewtonOptions& opt) {
+  GridObjective obj(in, dt);
+  VecXd u = obj.initial();
+  NewtonReport rep = newton_minimise(obj, u, opt);
+  if (!rep.converged) return rep;
+  SparseGrid& grid = *in.grid;
+  for (std::size_t g = 0; g < grid.num_grid_blocks(); ++g)
+    for (int n = 0; n < kBlockNodes; ++n) {
+      GridNode& nd = grid.gblock_nodes[g][n];
+      if (!(nd.m > 0)) continue;
+      for (int a = 0; a < 3; ++a) nd.v[a] = static_cast<Real>(u[3 * (g * kBlockNodes + n) + a]);
+    }
+  return rep;
+}
+
+}  // namespace shellmpm

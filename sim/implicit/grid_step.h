@@ -1,0 +1,55 @@
+// Backward Euler on the MPM grid for bulk materials (Gast, Schroeder, Stomakhin, Jiang and
+// Teran 2015). After a P2G of mass and momentum only (no stress), one step of dt minimises
+// over the velocities v_i of the massive grid nodes
+//   E(v) = sum_i m_i |v_i - v_i^n|^2 / 2 - dt sum_i m_i g . v_i + sum_p V_p psi(F_p(v)),
+//   F_p(v) = (I + dt sum_i v_i (grad w_ip)^T) F_p^n,
+// the elastic energy at the positions the nodes would move to (the supplement's forces as
+// functions of x* = x + dt v, "ignoring further plastic flow"). grad w_ip is the kernel
+// gradient (APIC) or MLS's 4 w_ip (x_i - x_p) / dx^2, the same velocity gradient G2P applies
+// to F afterwards. Plasticity (sand, snow) is applied after the step by its stage, as in
+// the explicit path.
+//
+// Constraints, projected inside CG (newton.h): nodes without mass; the domain walls
+// (a component whose predicted velocity v^n + dt g points into a wall within kWallCells is
+// held at 0); colliders, from the predicted velocity: sticky nodes take the collider's
+// velocity, slip and separate (approaching) nodes keep the collider's normal velocity and
+// move freely along the surface (the collider stage then applies friction and separation
+// to the solution, as after the explicit grid update).
+//
+// Everything is double: the constitutive models in ConstitutiveModelT<double>, the node
+// velocities, the sums. Per-node sums are gathered from per-particle-block buffers in the
+// grid's fixed order (sim/mpm/sparse_grid.h), so a solve is the same for any thread count.
+// Jacobi preconditioner: m_i + dt^2 sum_p V_p c_p |grad w_ip|^2, c_p the particle's wave
+// modulus (sim/mpm/constitutive.h).
+#pragma once
+#include <vector>
+
+#include "sim/collider/collider.h"
+#include "sim/implicit/newton.h"
+#include "sim/mpm/constitutive.h"
+#include "sim/mpm/particles.h"
+#include "sim/mpm/sparse_grid.h"
+
+namespace shellmpm {
+
+struct GridStepInput {
+  const ParticleSet* particles = nullptr;  ///< binned into `grid` (bulk only)
+  SparseGrid* grid = nullptr;              ///< after a P2G without stress: mass, momentum
+  const std::vector<ConstitutiveModelT<double>>* models = nullptr;
+  const std::vector<Real>* densities = nullptr;
+  const std::vector<Collider>* colliders = nullptr;  ///< posed for the step (begin_step)
+  Vec3d gravity{0, 0, 0};
+  Vec3i domain_cells{0, 0, 0};
+  int wall_cells = 3;
+  bool mls = false;
+  bool serial = false;
+};
+
+/// The objective of one grid step (for tests) and its start (v^n + dt g, constraints applied).
+std::unique_ptr<ImplicitObjective> grid_objective(const GridStepInput& in, double dt, VecXd& u0);
+
+/// One step: on convergence writes the node velocities into the grid (v, in place of the
+/// momentum) and returns; otherwise leaves the grid's mass and momentum as they were.
+NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const NewtonOptions& opt);
+
+}  // namespace shellmpm

@@ -1,0 +1,56 @@
+#include "sim/solver/stages/implicit_grid.h"
+
+#include <sstream>
+
+#include "sim/core/simulation_error.h"
+#include "sim/implicit/grid_step.h"
+#include "sim/solver/stages/scene_rules.h"
+
+namespace shellmpm {
+
+bool ImplicitGridStage::needed(const Scene& s) {
+  return s.shot.integrator == Integrator::Implicit && grid_needed(s);
+}
+
+void ImplicitGridStage::run(StepContext& c) {
+  if (models_.empty())
+    for (const MaterialDesc& m : c.scene.materials)
+      models_.push_back(ConstitutiveModelT<double>::from_desc(m));
+  const ShotSettings& shot = c.scene.shot;
+  GridStepInput in;
+  in.particles = &c.particles;
+  in.grid = &c.grid;
+  in.models = &models_;
+  in.densities = &c.densities;
+  in.colliders = &c.colliders;
+  in.gravity = shot.gravity;
+  in.domain_cells = c.domain_cells;
+  in.wall_cells = kWallCells;
+  in.mls = shot.transfer == Transfer::Mls;
+  in.serial = c.opt.serial;
+  const NewtonOptions opt = newton_options(shot);
+  double dt = c.dt;
+  while (true) {
+    for (Collider& col : c.colliders) col.begin_step(c.time, dt);
+    const NewtonReport rep = implicit_grid_step(in, dt, opt);
+    c.implicit_frame.add(rep.iterations, rep.cg_iterations, rep.residual);
+    if (rep.converged) break;
+    ++c.implicit_frame.retries;
+    dt *= 0.5;
+    if (dt < shot.dt_min) {
+      std::ostringstream os;
+      os << "at t = " << c.time
+         << " s the implicit grid step did not converge even at dt = " << 2 * dt << " s (residual "
+         << rep.residual << " m/s after " << rep.iterations << " Newton iterations"
+         << (rep.line_search_failed ? ", the line search found no decrease" : "")
+         << "; shot.implicit_tolerance = " << shot.implicit_tolerance
+         << " m/s); raise shot.newton_max_iterations or shot.implicit_tolerance, or lower "
+            "shot.dt_min";
+      throw SimulationError(os.str());
+    }
+  }
+  c.dt = dt;
+  c.apply_walls();
+}
+
+}  // namespace shellmpm
