@@ -28,6 +28,8 @@ class GridObjective final : public ImplicitObjective {
     vhat_.setZero(3 * m_.size());
     fixed_.assign(3 * nodes, 1);
     normal_.assign(nodes, Vec3d::Zero());
+    collider_of_.assign(nodes, -1);
+    position_.assign(nodes, Vec3d::Zero());
     u0_.setZero(3 * m_.size());
     vbuf_.resize(grid_.num_particle_blocks());
     fbuf_.resize(grid_.num_particle_blocks());
@@ -65,6 +67,39 @@ class GridObjective final : public ImplicitObjective {
   }
 
   void gradient(const VecXd& u, VecXd& g) override {
+    raw_gradient(u, g);
+    project(g);
+  }
+
+  /// Coulomb friction at the slip and separate collider nodes (the explicit collider
+  /// stage's rule, with the constraint's impulse for the approach it stops): the normal
+  /// impulse per unit mass the constraint applies at the solution u, j = (g . n) / m
+  /// from the unprojected gradient, removes up to friction * j of the tangential
+  /// velocity relative to the collider.
+  void apply_friction(VecXd& u) {
+    VecXd g;
+    raw_gradient(u, g);
+    for (Eigen::Index i = 0; i < m_.size(); ++i) {
+      if (collider_of_[i] < 0) continue;
+      const Collider& col = (*in_.colliders)[collider_of_[i]];
+      const double mu = col.desc().friction;
+      const Vec3d& n = normal_[i];
+      // m (u - v^n) - dt f = g: the constraint's impulse is g, its normal part g . n.
+      const double j = g.segment<3>(3 * i).dot(n) / m_[i];
+      if (!(mu > 0) || !(j > 0)) continue;
+      const Vec3d vc = col.velocity(position_[i]);
+      const Vec3d vr = u.segment<3>(3 * i) - vc;
+      const double vn = vr.dot(n);
+      const Vec3d vt = vr - vn * n;
+      const double tn = vt.norm(), drop = mu * j;
+      u.segment<3>(3 * i) =
+          vc + vn * n + (tn <= drop ? Vec3d::Zero() : Vec3d(vt * (1 - drop / tn)));
+    }
+  }
+
+ private:
+  /// dE/du without the constraints' projection.
+  void raw_gradient(const VecXd& u, VecXd& g) {
     scatter(u);
     elastic(&fbuf_);
     g.setZero(size());
@@ -74,9 +109,9 @@ class GridObjective final : public ImplicitObjective {
       g.segment<3>(3 * i) +=
           m_[i] * (u.segment<3>(3 * i) - vhat_.segment<3>(3 * i) - dt_ * in_.gravity);
     }
-    project(g);
   }
 
+ public:
   void apply_preconditioner(const VecXd& r, VecXd& z) const override { z = r.cwiseQuotient(diag_); }
 
   void project(VecXd& d) const override {
@@ -95,7 +130,8 @@ class GridObjective final : public ImplicitObjective {
     Vec3d v = vhat_.segment<3>(3 * i) + dt_ * in_.gravity;
     if (in_.colliders) {
       const Vec3d x = grid_.node_position(c);
-      for (const Collider& col : *in_.colliders) {
+      for (std::size_t k = 0; k < in_.colliders->size(); ++k) {
+        const Collider& col = (*in_.colliders)[k];
         if (col.phi(x) > 0) continue;
         const Vec3d n = col.normal(x), vc = col.velocity(x);
         const BoundaryKind kind = col.desc().boundary;
@@ -105,6 +141,8 @@ class GridObjective final : public ImplicitObjective {
         } else if (kind == BoundaryKind::Slip || (v - vc).dot(n) < 0) {
           v -= (v - vc).dot(n) * n;  // the collider's normal velocity, free along it
           normal_[i] = n;
+          collider_of_[i] = static_cast<int>(k);
+          position_[i] = x;
         }
         break;
       }
@@ -250,7 +288,9 @@ class GridObjective final : public ImplicitObjective {
   std::size_t nb_ = 0;
   VecXd m_, vhat_, u0_, diag_;
   std::vector<char> fixed_;
-  std::vector<Vec3d> normal_;  // slip constraint normal per node (zero: none)
+  std::vector<Vec3d> normal_;     // slip constraint normal per node (zero: none)
+  std::vector<int> collider_of_;  // the collider of that constraint (-1: none)
+  std::vector<Vec3d> position_;   // the node's position where it has one
   std::vector<Pad> vbuf_, fbuf_;
 };
 
@@ -267,6 +307,7 @@ NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const Newton
   VecXd u = obj.initial();
   NewtonReport rep = newton_minimise(obj, u, opt);
   if (!rep.converged) return rep;
+  obj.apply_friction(u);
   SparseGrid& grid = *in.grid;
   for (std::size_t g = 0; g < grid.num_grid_blocks(); ++g)
     for (int n = 0; n < kBlockNodes; ++n) {

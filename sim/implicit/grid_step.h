@@ -13,8 +13,9 @@
 // (a component whose predicted velocity v^n + dt g points into a wall within kWallCells is
 // held at 0); colliders, from the predicted velocity: sticky nodes take the collider's
 // velocity, slip and separate (approaching) nodes keep the collider's normal velocity and
-// move freely along the surface (the collider stage then applies friction and separation
-// to the solution, as after the explicit grid update).
+// move freely along the surface. Coulomb friction follows the solve at those nodes, with
+// the normal impulse the constraint applied (the explicit collider stage takes it from the
+// approach speed, which the constraint has already stopped here).
 //
 // Everything is double: the constitutive models in ConstitutiveModelT<double>, the node
 // velocities, the sums. Per-node sums are gathered from per-particle-block buffers in the

@@ -377,8 +377,23 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   const double permute = (kVec3 + kMat3) * n.peak_particles();
   // Contact and integrity scratch of a step (measured: about 200 bytes per contact site).
   const double contact_scratch = 200 * n.contact_sites;
+  // The implicit grid solve (sim/implicit/grid_step.cpp): about 17 double vectors of 3 per
+  // grid node (the objective's, Newton's and CG's) and two double buffers per particle block.
+  const double implicit_grid =
+      scene.shot.integrator == Integrator::Implicit
+          ? n.grid_blocks * 64 * 17 * 24.0 + n.particle_blocks * 2 * 216 * 24.0
+          : 0.0;
+  // The implicit shell step: the finite-difference tangent (9 entries of a value and an
+  // index for each of about 37 coupled points per control point, 4 kB) and, factorised,
+  // its LDL^T factor (fill-in assumed 3x the tangent, not yet measured).
+  double implicit_shells = 0;
+  if (scene.shot.integrator == Integrator::Implicit)
+    implicit_shells =
+        n.shell_points *
+        (scene.shot.implicit_preconditioner == ImplicitPreconditioner::Factorised ? 16e3 : 4e3);
   out.held_bytes = held;
-  out.step_scratch = std::max({t.force_scratch + contact_scratch, growth, permute});
+  out.step_scratch = std::max(
+      {t.force_scratch + contact_scratch + implicit_grid + implicit_shells, growth, permute});
   // Built: the shells one by one, then contact and integrity, then the fill particles
   // (each source's points in a vector of Vec3d, doubled by push_back, before they move
   // into the particle arrays).

@@ -182,3 +182,42 @@ TEST_CASE("implicit grid: the same bits with and without threads", "[implicit]")
     REQUIRE(a.particles().F[q] == b.particles().F[q]);
   }
 }
+
+TEST_CASE(
+    "implicit grid: a block sliding on a collider keeps its speed without friction and slows "
+    "with it",
+    "[implicit]") {
+  // 0: frictionless, 1: friction 0.5, 2: friction 0.5 explicit (the reference).
+  double slid[3] = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    Scene s = k < 2 ? implicit(jelly(), 1.0 / 96) : jelly();
+    s.materials[0].youngs_modulus = 1e5;
+    ColliderDesc ground;
+    ground.name = "ground";
+    ground.shape.kind = ShapeDesc::Kind::Plane;
+    ground.shape.point = Vec3d(0, 0.29, 0);  // just under the block
+    ground.shape.normal = Vec3d(0, 1, 0);
+    ground.boundary = BoundaryKind::Slip;
+    ground.friction = k == 0 ? 0.0 : 0.5;
+    s.colliders.push_back(ground);
+    Solver solver(s);
+    for (Vec3& v : solver.particles().v) v = Vec3(1, 0, 0);
+    const double p0 = momentum(solver).x();
+    double prev = p0;
+    for (int f = 1; f <= 4; ++f) {
+      solver.advance_to(f / 48.0);
+      const double px = momentum(solver).x();
+      CHECK(px <= prev * (1 + 1e-6));  // friction never pushes
+      prev = px;
+    }
+    slid[k] = prev / p0;
+  }
+  INFO("x momentum kept: " << slid[0] << " frictionless, " << slid[1] << " with friction 0.5, "
+                           << slid[2] << " explicit");
+  CHECK(slid[0] > 0.99);
+  // Friction after the solve, on the contact nodes only, stops less of the block at large
+  // steps than the explicit path (measured: 0.23 of its momentum against 0.33 at 2 steps
+  // per frame): at least half of it here.
+  CHECK(1 - slid[1] > 0.5 * (1 - slid[2]));
+  CHECK(slid[1] > slid[2] - 0.01);  // and never more
+}
