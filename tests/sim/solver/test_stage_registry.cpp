@@ -131,3 +131,24 @@ TEST_CASE("every registered stage is reachable, once, in one execution order", "
   // And nothing to simulate: no stage at all.
   REQUIRE(stages_of(base_scene()).empty());
 }
+
+TEST_CASE(
+    "implicit: implicit_grid takes grid's place, implicit_shells the shells' forces and "
+    "update",
+    "[stages][implicit]") {
+  Scene lone = base_scene();
+  add_sheet(lone, "a", 0, ShellDesc::Contact::Off);
+  lone.shot.integrator = Integrator::Implicit;
+  REQUIRE(stages_of(lone) == Names{"implicit_shells"});
+  // The implicit stages with everything else an implicit scene may ask for (no shell in
+  // contact: refused by the scene reader).
+  Scene s = base_scene();
+  add_sheet(s, "b", 0.2, ShellDesc::Contact::Off);
+  s.shell_materials[0].yield_stress = 1e6;
+  add_source(s, MaterialKind::Elastic, false);
+  add_source(s, MaterialKind::Sand, true);
+  add_ground(s);
+  s.shot.integrator = Integrator::Implicit;
+  REQUIRE(stages_of(s) == Names{"bin", "p2g", "implicit_grid", "implicit_shells", "colliders",
+                                "g2p", "collider_particles", "plasticity", "denting", "emit"});
+}
