@@ -79,6 +79,7 @@ class CheckedFile::Buffer : public std::streambuf {
   }
   std::streamsize xsputn(const char* s, std::streamsize n) override {
     if (error_ != 0) return 0;
+    if (n <= 0) return 0;  // an empty write (s may be null: memcpy must not see it)
     const auto room = epptr() - pptr();
     if (n <= room) {
       std::memcpy(pptr(), s, static_cast<std::size_t>(n));

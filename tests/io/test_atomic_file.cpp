@@ -151,6 +151,23 @@ TEST_CASE("CheckedFile writes through write() and a seekable stream", "[atomic]"
   CHECK_THROWS_AS(CheckedFile(dir.file("missing/a.bin")), std::system_error);
 }
 
+TEST_CASE("CheckedFile takes empty writes from an empty vector's null data()", "[atomic]") {
+  // Checkpoints write empty sections (no particles, no plastic state) with data() null;
+  // the sanitizer build caught them reaching memcpy, which must not see a null pointer.
+  TempDir dir("checked_file_empty");
+  const std::string path = dir.file("e.bin");
+  const std::vector<float> empty;
+  {
+    CheckedFile f(path);
+    f.write("a", 1);
+    f.stream().write(reinterpret_cast<const char*>(empty.data()), 0);
+    f.write(empty.data(), 0);
+    f.write("b", 1);
+    f.close();
+  }
+  CHECK(read_text(path) == "ab");
+}
+
 TEST_CASE(
     "every writer, past the file size limit: an error naming the file, the old file intact, no "
     "temporary",
