@@ -91,6 +91,7 @@ struct Cursor {
   std::size_t left() const { return static_cast<std::size_t>(end - p); }
   void take(void* dst, std::size_t n, const std::string& what) {
     if (n > left()) fail(what + " runs past the end of the payload");
+    if (n == 0) return;  // an empty array: its data() may be null, which memcpy must not see
     std::memcpy(dst, p, n);
     p += n;
   }

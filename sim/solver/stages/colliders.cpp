@@ -32,6 +32,12 @@ void CollidersStage::run(StepContext& c) {
         }
       },
       c.opt.serial);
+  // The domain walls after the colliders: a ground within kWallCells of the domain's edge
+  // must see the node's velocity into it, or the wall (frictionless) would zero it first
+  // and the ground's Coulomb friction, which scales with that velocity, would never act
+  // (a sand pile crept over a rough ground at dx 0.02, its floor 2.5 cells above the
+  // domain's edge, as over ice).
+  c.apply_walls();
 }
 
 }  // namespace shellmpm

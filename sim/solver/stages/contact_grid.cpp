@@ -11,7 +11,7 @@ bool ContactGridStage::needed(const Scene& s) {
 void ContactGridStage::run(StepContext& c) {
   contact_normal_forces(c.grid, c.shell_table, c.grid_shells, static_cast<Real>(c.dt),
                         c.opt.serial);
-  c.apply_walls();
+  if (c.colliders.empty()) c.apply_walls();  // else after the colliders (colliders.cpp)
 }
 
 }  // namespace shellmpm

@@ -14,7 +14,9 @@ bool GridUpdateStage::needed(const Scene& s) {
 void GridUpdateStage::run(StepContext& c) {
   const Vec3 g = c.scene.shot.gravity.cast<Real>();
   const Real dt = static_cast<Real>(c.dt);
-  const bool walls = c.grid_shells.empty();
+  // The domain walls act here unless a later stage applies them: the contact grid (shells
+  // in contact) or the colliders, which must see the velocity before the walls clamp it.
+  const bool walls = c.grid_shells.empty() && c.colliders.empty();
   parallel_for_each(
       c.grid.num_grid_blocks(), 16,
       [&](std::size_t b) {
