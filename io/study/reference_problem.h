@@ -40,6 +40,10 @@ struct ReferenceProblem {
   std::function<double(const Scene&)> reference;
   /// The measured value from the finished run.
   std::function<double(const RunFolder&, const Scene&)> measure;
+  /// Why the finished run's measurement cannot be trusted ("" where it can): a flow that
+  /// has not come to rest, say. Such runs are listed as doubtful with the reason, and
+  /// left out of the fitted orders and the Pareto front (null: always trusted).
+  std::function<std::string(const RunFolder&, const Scene&)> doubt;
   std::vector<StudySweep> sweeps;  ///< the first is the refinement shown in the convergence plot
 };
 

@@ -148,11 +148,18 @@ void write_study_report(const StudyResults& r, const std::string& output) {
     for (const StudyRun& run : p.runs) {
       const long points = run.particles + run.shell_points;
       md << "| " << run.sweep << " | " << run.label << " | "
-         << (run.status == "ok" ? g(run.value, 5) : run.status) << " | " << g(run.reference, 5)
-         << " | " << error_text(p, run.error) << " | " << g(run.wall_seconds, 3) << " | "
-         << g(run.cost, 3) << " | " << run.substeps << " | " << points << " | "
-         << g(run.peak_rss_bytes / 1e6, 3) << " | " << (run.pareto ? "yes" : "") << " |\n";
+         << (run.status == "ok"         ? g(run.value, 5)
+             : run.status == "doubtful" ? g(run.value, 5) + " (doubtful)"
+                                        : run.status)
+         << " | " << g(run.reference, 5) << " | " << error_text(p, run.error) << " | "
+         << g(run.wall_seconds, 3) << " | " << g(run.cost, 3) << " | " << run.substeps << " | "
+         << points << " | " << g(run.peak_rss_bytes / 1e6, 3) << " | " << (run.pareto ? "yes" : "")
+         << " |\n";
     }
+    for (const StudyRun& run : p.runs)
+      if (!run.note.empty() && run.status != "skipped")
+        md << "\n- " << run.label << ", " << run.status << ": " << run.note;
+    md << "\n";
     for (const StudySweepResult& s : p.sweeps) {
       if (!s.refinement) continue;
       md << "\n" << s.name << " (" << s.varied << "; held: " << s.held << "): ";

@@ -93,6 +93,10 @@ void run_one(const StudyOptions& opt, const ReferenceProblem& p, const std::stri
         p.relative_error ? (r.value - r.reference) / std::abs(r.reference) : r.value - r.reference;
     r.status = std::isfinite(r.error) ? "ok" : "failed";
     if (r.status != "ok") r.note = "the measurement is not finite";
+    if (r.status == "ok" && p.doubt) {
+      r.note = p.doubt(rf, scene);
+      if (!r.note.empty()) r.status = "doubtful";
+    }
   } catch (const std::exception& e) {
     r.status = "failed";
     r.note = e.what();
@@ -228,13 +232,17 @@ StudyResults run_study(const StudyOptions& opt) {
       fs::remove_all(dir, ec);
       run_one(opt, p, plans[pi].scene_path, plans[pi].scenes[i], dir, r);
       if (!opt.keep_runs && r.status == "ok") fs::remove_all(dir, ec);
+      const bool measured = r.status == "ok" || r.status == "doubtful";
       log(p.name + " [" + r.sweep + "] " + r.label + ": " +
-          (r.status == "ok" ? "value " + std::to_string(r.value) + " " + p.unit + ", reference " +
-                                  std::to_string(r.reference) + ", error " +
-                                  (p.relative_error ? fixed(100 * r.error, 2) + "%"
-                                                    : std::to_string(r.error) + " " + p.unit) +
-                                  ", " + fixed(r.wall_seconds, 1) + " s"
-                            : r.status + " (" + r.note + ")"));
+          (measured ? "value " + std::to_string(r.value) + " " + p.unit + ", reference " +
+                          std::to_string(r.reference) + ", error " +
+                          (p.relative_error ? fixed(100 * r.error, 2) + "%"
+                                            : std::to_string(r.error) + " " + p.unit) +
+                          ", " + fixed(r.wall_seconds, 1) + " s"
+                    : r.status) +
+          (r.note.empty()
+               ? std::string()
+               : " (" + std::string(r.status == "doubtful" ? "doubtful: " : "") + r.note + ")"));
     }
     mark_pareto_front(pr.runs);
     for (StudySweepResult& sw : pr.sweeps) fit_sweep(pr, sw);

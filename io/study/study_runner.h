@@ -33,7 +33,7 @@ struct StudyRun {
   std::string sweep, label;
   std::vector<std::string> overrides;
   double h = 0;
-  std::string status = "skipped";  ///< ok | failed | skipped
+  std::string status = "skipped";  ///< ok | doubtful | failed | skipped
   std::string note;                ///< why it failed or was skipped
   double value = std::numeric_limits<double>::quiet_NaN();
   double reference = std::numeric_limits<double>::quiet_NaN();

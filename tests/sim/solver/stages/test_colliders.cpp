@@ -70,7 +70,8 @@ TEST_CASE("a rough ground inside the domain walls' band still brakes a sliding b
     const double decel = (v[0] - v[3]) / (3.0 / 24);
     CHECK(decel == Approx(mu * g).epsilon(0.15));
     // Without friction it keeps its speed: the braking above is the ground's friction.
-    const std::vector<double> free = slide_speeds(sliding_sand(below, 0, BoundaryKind::Separate), 4);
+    const std::vector<double> free =
+        slide_speeds(sliding_sand(below, 0, BoundaryKind::Separate), 4);
     CHECK(free[3] > 0.97);
   }
 }
