@@ -117,3 +117,43 @@ TEST_CASE("CLI: converge measures a shot at three spacings and extrapolates", "[
   CHECK(j["settings"][2]["h"].get<double>() == Approx(0.025));
   CHECK(r.output.find("wrote") != std::string::npos);
 }
+
+TEST_CASE("CLI: the full study runs every problem within its budget; the converging ones converge",
+          "[study][cli][slow]") {
+  // The command docs/accuracy.md's figures come from (about 25-40 minutes on 2 cores).
+  TempDir dir("study_full");
+  const std::string out = dir.file("study");
+  const CmdResult r = run_shellmpm("study --threads 2 -o " + out);
+  INFO(r.output.substr(r.output.size() > 4000 ? r.output.size() - 4000 : 0));
+  REQUIRE(r.code == 0);
+  const nlohmann::json j = nlohmann::json::parse(read_text(out + "/results.json"));
+  CHECK(j["problems"].size() == 8);
+  for (const nlohmann::json& p : j["problems"]) {
+    const std::string name = p["name"];
+    INFO(name);
+    for (const nlohmann::json& run : p["runs"]) {
+      INFO(run["label"].get<std::string>() << ": " << run.value("note", ""));
+      CHECK(run["status"] != "failed");
+      CHECK(run["status"] != "skipped");  // the default budget holds the whole study
+    }
+    // Problems with a smooth answer converge: the error falls at every refinement and the
+    // Richardson limit lands within 0.5% of the reference.
+    const bool smooth = name == "plate_simply_supported" || name == "cantilever_gravity" ||
+                        name == "cantilever_vibration" || name == "bar_impact";
+    if (!smooth) continue;
+    const nlohmann::json& sweep = p["sweeps"][0];
+    REQUIRE(sweep["refinement"] == true);
+    double previous = INFINITY;
+    for (int i : sweep["runs"]) {
+      const double e = std::abs(p["runs"][i]["error"].get<double>());
+      CHECK(e < previous);
+      previous = e;
+    }
+    REQUIRE(sweep.contains("richardson"));
+    const double ref = p["runs"][sweep["runs"][0].get<int>()]["reference"];
+    CHECK(sweep["richardson"]["limit"].get<double>() == Approx(ref).epsilon(0.005));
+    CHECK(sweep["fitted_order"].get<double>() > 0.6);
+  }
+  CHECK(std::filesystem::exists(out + "/results.csv"));
+  CHECK(std::filesystem::exists(out + "/summary.md"));
+}
