@@ -1,9 +1,25 @@
 // Bardenhagen's contact rule between two velocity fields at one grid node (Bardenhagen
 // et al. 2000, "Contact algorithm for granular materials"; used by shell_fields.cpp).
 #pragma once
+#include <algorithm>
+#include <cmath>
+
 #include "sim/core/types.h"
 
 namespace shellmpm {
+
+/// The inverse effective mass of a field with mass m at a node, `held` of it pinned (a
+/// pinned share is infinitely heavy): (m - held) / m^2. Divided in two steps, since m^2
+/// underflows to zero for m below about 1e-19 in float (a node a stencil's far tips reach),
+/// which gave inf or NaN; a mass that is not a normal number takes no part (0): its
+/// reciprocal would overflow.
+inline Real inverse_field_mass(Real m, Real held) {
+  if (!std::isnormal(m) || m < 0) return Real(0);
+  const Real mm = m * m;
+  // Where m^2 is a normal number, the one division as before (same results).
+  if (std::isnormal(mm)) return std::max(m - held, Real(0)) / mm;
+  return std::max(m - held, Real(0)) / m / m;
+}
 
 /// Fields a and b at one node: n the unit normal from a towards b, wa and wb their
 /// inverse masses (0: pinned, infinitely heavy), va and vb their velocities. When they

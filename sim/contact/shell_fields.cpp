@@ -229,7 +229,7 @@ void ShellFields::body_geometry(Body& B) {
   B.nrm = nl > 0 ? Vec3(ns / nl) : Vec3::Zero();
   B.own = Nl > 0 ? Vec3(Ns / Nl) : Vec3::Zero();
   B.off = Vec3(f.o[0], f.o[1], f.o[2]);
-  B.winv = std::max(f.m - f.held, Real(0)) / (f.m * f.m);
+  B.winv = inverse_field_mass(f.m, f.held);
 }
 
 void ShellFields::shell_pairs(std::vector<Body>& bodies) const {

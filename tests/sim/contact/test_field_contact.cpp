@@ -1,5 +1,7 @@
 // Bardenhagen's pair rule between two velocity fields at a node (sim/contact/field_contact.h).
 #include <catch2/catch.hpp>
+#include <cmath>
+#include <limits>
 
 #include "sim/contact/field_contact.h"
 
@@ -63,4 +65,27 @@ TEST_CASE("a pinned field (inverse mass 0) does not move, and the other takes it
   field_contact(n, 0, 0, a, 0, b);
   CHECK(a == Vec3(1, 0, 0));
   CHECK(b == Vec3(-1, 0, 0));
+}
+
+TEST_CASE("a field's inverse mass stays finite for tiny masses, and the rule with it",
+          "[field_contact]") {
+  CHECK(inverse_field_mass(2, 0) == Approx(0.5));
+  CHECK(inverse_field_mass(2, 2) == 0);  // fully pinned: infinitely heavy
+  CHECK(inverse_field_mass(2, 1) == Approx(0.25));
+  CHECK(inverse_field_mass(0, 0) == 0);  // no mass: no part
+  // m^2 underflows to zero (float: m below about 4e-23): the old (m - held) / (m m)
+  // was 0/0 or x/0 there.
+  const Real tiny = std::sqrt(std::numeric_limits<Real>::denorm_min()) / 4;  // m m == 0
+  const Real w = inverse_field_mass(tiny, 0);
+  CHECK(std::isfinite(w));
+  CHECK(w == Approx(1 / tiny).epsilon(1e-5));  // (m - 0) / m^2 = 1 / m
+  CHECK(inverse_field_mass(tiny, tiny / 2) == Approx(0.5 * w).epsilon(1e-5));
+  // A subnormal mass takes no part, rather than an infinite inverse mass.
+  CHECK(inverse_field_mass(std::numeric_limits<Real>::denorm_min(), 0) == 0);
+  // Two such fields meeting: velocities stay finite and end with one normal velocity.
+  Vec3 va(0, 1, 0), vb(0, -1, 0);
+  field_contact(Vec3(0, 1, 0), Real(0.3), w, va, inverse_field_mass(2 * tiny, 0), vb);
+  CHECK(va.allFinite());
+  CHECK(vb.allFinite());
+  CHECK(va.y() == Approx(vb.y()));
 }
