@@ -100,7 +100,8 @@ def main():
     out = sys.argv[2]
     os.makedirs(out, exist_ok=True)
     written = []
-    problems = results["problems"]
+    # Problems with no measured run (a --sweep its problem does not have) get no plots.
+    problems = [p for p in results["problems"] if any(abs_error(r) is not None for r in p["runs"])]
     for p in problems:
         fig, ax = plt.subplots(figsize=(7, 5))
         pareto_axes(ax, p)

@@ -231,7 +231,9 @@ StudyResults run_study(const StudyOptions& opt) {
       std::error_code ec;
       fs::remove_all(dir, ec);
       run_one(opt, p, plans[pi].scene_path, plans[pi].scenes[i], dir, r);
-      if (!opt.keep_runs && r.status == "ok") fs::remove_all(dir, ec);
+      // Measured runs go (the doubtful ones too: their measurement is in the results);
+      // failed ones stay for their logs.
+      if (!opt.keep_runs && (r.status == "ok" || r.status == "doubtful")) fs::remove_all(dir, ec);
       const bool measured = r.status == "ok" || r.status == "doubtful";
       log(p.name + " [" + r.sweep + "] " + r.label + ": " +
           (measured ? "value " + std::to_string(r.value) + " " + p.unit + ", reference " +
