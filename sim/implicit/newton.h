@@ -52,7 +52,9 @@ class ImplicitObjective {
 
 struct NewtonOptions {
   /// Converged when the residual, the largest entry of the correction P^-1 g the
-  /// gradient asks for (a velocity for the objectives here), is at most this [m/s].
+  /// gradient asks for (a velocity for the objectives here), is at most this [m/s], and
+  /// so is the Newton step CG then finds (a weak preconditioner can make P^-1 g small
+  /// where the step is not).
   /// (Not max |g_i| / m_i: where the stiffness dominates the mass, dt^2 K >> m, that
   /// overstates the correction by dt^2 K / m and stalls at the gradient's round-off.)
   double tolerance = 1e-4;

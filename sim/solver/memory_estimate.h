@@ -30,6 +30,7 @@ struct MemoryCounts {
   double particle_blocks = 0;    ///< occupied 4^3-cell blocks of the combined grid
   double grid_blocks = 0;        ///< their grid blocks (each particle block and its +1 neighbours)
   double shell_points = 0;       ///< control points of all shells
+  double largest_shell = 0;      ///< control points of the largest shell
   double shell_triangles = 0;    ///< control-mesh triangles of all shells
   double quadrature_points = 0;  ///< Kirchhoff-Love in-plane quadrature points, all shells
   double contact_sites = 0;      ///< contact particles (shells with contact)
