@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sim/solver/solver.h"
+#include "tests/support/bulk_fixtures.h"
 #include "tests/support/least_squares.h"
 #include "tests/support/shell_fixtures.h"
 
@@ -394,12 +395,7 @@ TEST_CASE("sand poured onto a cloth pinned at its corners is held: no sand passe
     cl.pins.push_back(p);
   }
   s.shells.push_back(cl);
-  MaterialDesc sand;
-  sand.name = "sand";
-  sand.kind = MaterialKind::Sand;
-  sand.youngs_modulus = 3e5;
-  sand.density = 1600;
-  sand.friction_angle_deg = 35;
+  const MaterialDesc sand = test::sand_material(3e5, 35);
   add_box_source(s, sand, Vec3d(-0.05, 0.06, -0.05), Vec3d(0.05, 0.11, 0.05), Vec3d(0, -1, 0));
   Solver solver(s);
   REQUIRE(solver.shell_on_grid(0));

@@ -5,6 +5,7 @@
 
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
+#include "tests/support/bulk_fixtures.h"
 
 using namespace shellmpm;
 
@@ -112,14 +113,7 @@ TEST_CASE("a sand column collapses and comes to rest with no particle lost", "[s
   s.shot.dx = 0.02;
   s.shot.domain_min = Vec3d(-0.5, 0, -0.5);
   s.shot.domain_max = Vec3d(0.5, 0.5, 0.5);
-  MaterialDesc sand;
-  sand.name = "sand";
-  sand.kind = MaterialKind::Sand;
-  sand.youngs_modulus = 3e4;
-  sand.poisson_ratio = 0.3;
-  sand.density = 1600;
-  sand.friction_angle_deg = 35;
-  s.materials.push_back(sand);
+  s.materials.push_back(test::sand_material(3e4, 35));
   SourceDesc col;
   col.shape.kind = ShapeDesc::Kind::Box;
   col.shape.min = Vec3d(-0.06, 0.06, -0.06);

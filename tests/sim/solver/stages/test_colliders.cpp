@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "sim/solver/solver.h"
+#include "tests/support/bulk_fixtures.h"
 
 using namespace shellmpm;
 
@@ -19,14 +20,7 @@ Scene sliding_sand(double below, double friction, BoundaryKind boundary) {
   s.shot.fps = 24;
   s.shot.domain_min = Vec3d(-0.1, -below, -0.1);
   s.shot.domain_max = Vec3d(0.7, 0.2, 0.1);
-  MaterialDesc sand;
-  sand.name = "sand";
-  sand.kind = MaterialKind::Sand;
-  sand.youngs_modulus = 1e5;
-  sand.poisson_ratio = 0.3;
-  sand.density = 1600;
-  sand.friction_angle_deg = 32;
-  s.materials.push_back(sand);
+  s.materials.push_back(test::sand_material(1e5, 32));
   SourceDesc block;
   block.shape.kind = ShapeDesc::Kind::Box;
   block.shape.min = Vec3d(0.0, 0.0, -0.03);
