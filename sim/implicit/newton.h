@@ -64,6 +64,10 @@ struct NewtonOptions {
   /// cg_min_eta, cg_max_eta) (inexact Newton: loose far away, tight near the solution).
   double cg_max_eta = 0.5, cg_min_eta = 1e-4;
   bool refresh_preconditioner = false;
+  /// Rebuilds the preconditioner at the current iterate every this many iterations of a
+  /// solve that has not converged (0: never): one built at the start of a step with
+  /// large rotations stops describing H, and CG then needs many more iterations.
+  int refresh_after = 0;
   /// Armijo constant c1 and the most halvings of the step length.
   double armijo = 1e-4;
   int max_halvings = 30;

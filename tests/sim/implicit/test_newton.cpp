@@ -112,3 +112,47 @@ TEST_CASE("newton: the default Hessian product matches the analytic one", "[impl
     CHECK(hd[i] == Approx(h).epsilon(1e-6).margin(1e-9));
   }
 }
+
+TEST_CASE("newton: refresh_after rebuilds the preconditioner during a long solve", "[implicit]") {
+  // The quartic with a diagonal preconditioner, the inverse of H's diagonal where it was
+  // built: far from the minimum it is stale, and the refresh counts.
+  class Refreshed final : public ImplicitObjective {
+   public:
+    explicit Refreshed(int n) : q(n), diag(VecXd::Ones(n)) {}
+    Eigen::Index size() const override { return q.size(); }
+    double energy(const VecXd& u) override { return q.energy(u); }
+    void gradient(const VecXd& u, VecXd& g) override { q.gradient(u, g); }
+    void project(VecXd& d) const override { q.project(d); }
+    void prepare_preconditioner(const VecXd& u) override {
+      ++builds;
+      for (Eigen::Index i = 0; i < u.size(); ++i) {
+        const double d = u[i] - q.c[i];
+        diag[i] = 3 * q.a[i] * d * d + q.b[i] + 2 * q.k;
+      }
+    }
+    void apply_preconditioner(const VecXd& r, VecXd& z) const override {
+      z = r.cwiseQuotient(diag);
+    }
+    Quartic q;
+    VecXd diag;
+    int builds = 0;
+  };
+  for (int every : {0, 3}) {
+    CAPTURE(every);
+    Refreshed obj(30);
+    VecXd u = VecXd::Constant(30, 2.0);
+    NewtonOptions opt;
+    opt.tolerance = 1e-10;
+    opt.max_iterations = 100;
+    opt.refresh_after = every;
+    const NewtonReport rep = newton_minimise(obj, u, opt);
+    REQUIRE(rep.converged);
+    CHECK((u - obj.q.c).lpNorm<Eigen::Infinity>() < 1e-3);
+    REQUIRE(rep.iterations > 3);
+    // Built once at the start, then at every multiple of `every` iterations reached before
+    // convergence (the last check may come after the final iteration).
+    const int expected_min = every ? 1 + (rep.iterations - 1) / every : 1;
+    CHECK(obj.builds >= expected_min);
+    CHECK(obj.builds <= (every ? 1 + rep.iterations / every : 1));
+  }
+}
