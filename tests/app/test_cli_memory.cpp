@@ -172,7 +172,7 @@ TEST_CASE("CLI memory: the estimate against the peak resident size of runs",
            r + ", " + r + "]}, pins: [{box: {min: [-1, -1, -1], max: [-0.2499, 1, 1]}}]}\n";
   };
   const std::string scenes[] = {head + bulk, head + cloth, head + cloth + second,
-                                steel("block_jacobi", 96, "2e8"), steel("factorised", 80, "2e11")};
+                                steel("block_jacobi", 48, "2e8"), steel("factorised", 80, "2e11")};
   int k = 0;
   for (const std::string& text : scenes) {
     const std::string s = write_scene(d, text, "s" + std::to_string(k++) + ".yaml");
