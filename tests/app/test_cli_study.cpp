@@ -120,7 +120,7 @@ TEST_CASE("CLI: converge measures a shot at three spacings and extrapolates", "[
 
 TEST_CASE("CLI: the full study runs every problem within its budget; the converging ones converge",
           "[study][cli][slow]") {
-  // The command docs/accuracy.md's figures come from (about 25-40 minutes on 2 cores).
+  // The command docs/accuracy.md's figures come from (6.5 minutes on 2 quiet cores).
   TempDir dir("study_full");
   const std::string out = dir.file("study");
   const CmdResult r = run_shellmpm("study --threads 2 -o " + out);
