@@ -6,6 +6,7 @@
 #include "app/commands.h"
 #include "io/user_error.h"
 #include "sim/core/check.h"
+#include "sim/core/lsan_suppressions.h"
 #include "sim/scene/scene_words.h"
 #include "sim/solver/solver.h"
 
