@@ -39,7 +39,7 @@ class ImplicitObjective {
   /// (g(u + h d) - g(u - h d)) / 2h with h = 1e-6 (1 + |u|_inf) / |d|_inf.
   virtual void hessian_product(const VecXd& u, const VecXd& d, VecXd& out);
   /// Builds the preconditioner at u (called once per solve, at the start, or every
-  /// iteration with NewtonOptions::refresh_preconditioner). Default: none.
+  /// iteration with NewtonOptions::refresh_after = 1). Default: none.
   virtual void prepare_preconditioner(const VecXd& u) { (void)u; }
   /// z = P^-1 r (a symmetric positive definite approximation of H^-1). Default: z = r.
   virtual void apply_preconditioner(const VecXd& r, VecXd& z) const { z = r; }
@@ -63,10 +63,9 @@ struct NewtonOptions {
   /// CG stops when |r|_P <= eta |g|_P, eta = clamp(sqrt(residual / first residual),
   /// cg_min_eta, cg_max_eta) (inexact Newton: loose far away, tight near the solution).
   double cg_max_eta = 0.5, cg_min_eta = 1e-4;
-  bool refresh_preconditioner = false;
   /// Rebuilds the preconditioner at the current iterate every this many iterations of a
-  /// solve that has not converged (0: never): one built at the start of a step with
-  /// large rotations stops describing H, and CG then needs many more iterations.
+  /// solve that has not converged (0: never; 1: every iteration): one built at the start of a step
+  /// with large rotations stops describing H, and CG then needs many more iterations.
   int refresh_after = 0;
   /// Armijo constant c1 and the most halvings of the step length.
   double armijo = 1e-4;
