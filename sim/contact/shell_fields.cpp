@@ -232,6 +232,16 @@ void ShellFields::body_geometry(Body& B) {
   B.winv = inverse_field_mass(f.m, f.held);
 }
 
+Vec3 ShellFields::contact_normal(const Body& A, const Body& B, Real sign) {
+  const Real w = A.winv + B.winv;
+  if (std::isfinite(w) && w > 0) {
+    const Vec3 n = (B.winv / w) * A.nrm + sign * (A.winv / w) * B.nrm;
+    const Real l = n.norm();
+    if (l > Real(1e-6)) return n / l;
+  }
+  return (A.nrm + sign * B.nrm).normalized();
+}
+
 void ShellFields::shell_pairs(std::vector<Body>& bodies) const {
   const std::size_t cnt = bodies.size();
   for (std::size_t i = 0; i < cnt; ++i)
@@ -240,13 +250,13 @@ void ShellFields::shell_pairs(std::vector<Body>& bodies) const {
       const Real facing = A.nrm.dot(B.nrm);
       Vec3 nab;  // unit normal from a towards b
       if (facing < Real(-0.5)) {
-        nab = (A.nrm - B.nrm).normalized();
+        nab = contact_normal(A, B, Real(-1));
       } else if (facing > Real(0.5)) {
         // Both on the same side of the node: closer than a cell, no node between
         // them. The one whose centroid lies nearer the node along their common
         // normal u is in front; without this the rule let go exactly when two
         // sheets were pressed closest (hanging curtains hit at 20 m/s crossed).
-        const Vec3 u = (A.nrm + B.nrm).normalized();
+        const Vec3 u = contact_normal(A, B, Real(1));
         const Real h = u.dot(B.off - A.off);
         if (std::abs(h) < Real(0.05)) continue;
         nab = h > 0 ? u : Vec3(-u);
