@@ -45,18 +45,25 @@ std::vector<PresetMeasurement> preset_measurements(const std::string& results_js
   } catch (const std::exception&) {
     return out;
   }
+  if (!j.is_object()) return out;
   const std::string label = std::string("quality=") + word_of(quality);
   for (const std::string& name : problems)
     for (const nlohmann::json& p : j.value("problems", nlohmann::json::array())) {
-      if (p.value("name", "") != name) continue;
+      if (!p.is_object() || p.value("name", "") != name) continue;
       const nlohmann::json* mine = nullptr;
       const nlohmann::json* production = nullptr;
-      for (const nlohmann::json& r : p.value("runs", nlohmann::json::array())) {
-        if (r.value("sweep", "") != "quality preset" || r.value("status", "") != "ok") continue;
+      // value() returns a copy: kept here, since mine and production point into it (they
+      // dangled when the copy was the loop's temporary, and `check --quality` read freed
+      // memory).
+      const nlohmann::json runs = p.value("runs", nlohmann::json::array());
+      for (const nlohmann::json& r : runs) {
+        if (!r.is_object() || r.value("sweep", "") != "quality preset" ||
+            r.value("status", "") != "ok")
+          continue;
         if (r.value("label", "") == label) mine = &r;
         if (r.value("label", "") == "quality=production") production = &r;
       }
-      if (mine == nullptr || !(*mine)["error"].is_number()) continue;
+      if (mine == nullptr || !mine->contains("error") || !(*mine)["error"].is_number()) continue;
       PresetMeasurement m;
       m.problem = name;
       std::ostringstream e;
@@ -67,8 +74,9 @@ std::vector<PresetMeasurement> preset_measurements(const std::string& results_js
       else
         e << std::showpos << err << " " << p.value("unit", "");
       m.error = e.str();
-      if (production != nullptr && (*production)["cost"].get<double>() > 0)
-        m.cost_vs_production = (*mine)["cost"].get<double>() / (*production)["cost"].get<double>();
+      const double cost = mine->value("cost", 0.0);
+      const double cost_production = production ? production->value("cost", 0.0) : 0.0;
+      if (cost > 0 && cost_production > 0) m.cost_vs_production = cost / cost_production;
       out.push_back(m);
     }
   return out;

@@ -137,3 +137,19 @@ TEST_CASE("CLI values: an unquoted pattern in --set says how to quote it", "[cli
   INFO(ok.output);
   CHECK(ok.code == 0);
 }
+
+TEST_CASE("CLI values: check with a quality preset prints the study's measured errors",
+          "[cli][values]") {
+  // It read freed memory (a pointer into a temporary copy of the runs) and ended in a JSON
+  // library error, exit 1.
+  const std::string scene = std::string(SHELLMPM_SOURCE_DIR) + "/scenes/study/incline_sheet.yaml";
+  for (const char* q : {"draft", "preview", "production", "final"}) {
+    const CmdResult r = run_shellmpm("check " + scene + " --quality " + q);
+    INFO(q << ": " << r.output);
+    CHECK(r.code == 0);
+    CHECK(has(r, std::string("quality ") + q + ": dx"));
+    CHECK(has(r, "measured with this preset (docs/accuracy.md): incline_collider "));
+    CHECK(has(r, " incline_sheet "));
+    CHECK(!has(r, "json"));
+  }
+}
