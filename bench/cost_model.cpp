@@ -80,8 +80,7 @@ Timing time_scene(const Scene& scene, int threads, double work) {
   t.particles = solver.particles().size();
   const int steps = std::max(4, static_cast<int>(work / static_cast<double>(t.particles)));
   const shellmpm_bench::TimedAdvance r = shellmpm_bench::timed_advance(solver, steps * kDt);
-  t.ns_per_particle_step =
-      1e9 * r.seconds / (static_cast<double>(t.particles) * r.stats.substeps);
+  t.ns_per_particle_step = 1e9 * r.seconds / (static_cast<double>(t.particles) * r.stats.substeps);
   t.particle_bytes = static_cast<double>(solver.particles().bytes()) / t.particles;
   t.grid_bytes = static_cast<double>(solver.grid().bytes()) / t.particles;
   return t;
@@ -130,8 +129,8 @@ int main(int argc, char** argv) {
   std::printf("%-9s %5s %9s %9s %9s", "sweep", "cubes", "particles", "domain", "active");
   for (int n : threads) std::printf(" %6s ns", (std::to_string(n) + "t").c_str());
   for (std::size_t i = 1; i < threads.size(); ++i)
-    std::printf(" %7s", (std::to_string(threads[i]) + "t/" + std::to_string(threads[0]) + "t")
-                            .c_str());
+    std::printf(" %7s",
+                (std::to_string(threads[i]) + "t/" + std::to_string(threads[0]) + "t").c_str());
   std::printf(" %7s %6s\n", "B/part", "B/grid");
   // Size: one cube, 64k .. 4M particles (cells a side: cbrt(N / 8)).
   for (double n : {65536.0, 262144.0, 1048576.0, 4194304.0}) {
