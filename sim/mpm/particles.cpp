@@ -1,5 +1,6 @@
 #include "sim/mpm/particles.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "sim/core/check.h"
@@ -34,6 +35,20 @@ void ParticleSet::permute(const std::vector<std::uint32_t>& order) {
   permute_one(material, order, scratch);
   permute_one(id, order, scratch);
   permute_one(plastic, order, scratch);
+}
+
+void ParticleSet::reserve_more(std::size_t n, bool exact) {
+  const std::size_t need = size() + n;
+  if (need <= x.capacity()) return;
+  const std::size_t cap = exact ? need : std::max(need, size() + size() / 2);
+  x.reserve(cap);
+  v.reserve(cap);
+  C.reserve(cap);
+  F.reserve(cap);
+  volume.reserve(cap);
+  material.reserve(cap);
+  id.reserve(cap);
+  if (keep_plastic) plastic.reserve(cap);
 }
 
 std::size_t ParticleSet::bytes() const {

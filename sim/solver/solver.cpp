@@ -37,11 +37,19 @@ Solver::Solver(const Scene& scene, SolverOptions opt) {
   setup_contact();
   integrity_.setup(integrity_view(), s.dx);
   if (opt.fill_sources) {
+    // Every source's points first, so the particle arrays are allocated once, exactly.
+    std::vector<std::vector<Vec3d>> pts(c_.samplers.size());
+    std::size_t total = 0;
     for (std::size_t i = 0; i < c_.samplers.size(); ++i) {
       if (c_.scene.sources[i].emit) continue;
-      std::vector<Vec3d> pts;
-      c_.samplers[i].fill([&](const Vec3d& p) { pts.push_back(p); });
-      c_.add_particles_from(i, pts);
+      c_.samplers[i].fill([&](const Vec3d& p) { pts[i].push_back(p); });
+      total += pts[i].size();
+    }
+    c_.particles.reserve_more(total, true);
+    for (std::size_t i = 0; i < c_.samplers.size(); ++i) {
+      if (pts[i].empty()) continue;
+      c_.add_particles_from(i, pts[i]);
+      std::vector<Vec3d>().swap(pts[i]);
     }
     c_.clamp_to_domain();
   }

@@ -67,6 +67,7 @@ void StepContext::add_particles_from(std::size_t i, const std::vector<Vec3d>& pt
   const Real vol = static_cast<Real>(samplers[i].particle_volume());
   const Vec3 vel = src.velocity.cast<Real>();
   const Real pl0 = models[mat].initial_plastic();
+  particles.reserve_more(pts.size(), false);
   for (const Vec3d& p : pts) particles.push_back(p.cast<Real>(), vel, vol, mat, pl0);
 }
 
