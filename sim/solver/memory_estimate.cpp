@@ -295,11 +295,10 @@ double expected_source_particles(const SourceDesc& src, const ShotSettings& shot
 namespace {
 
 /// Bulk particles and the blocks they occupy (at rest density; emitted material counted
-/// as a loose pile, half full) into n; returns the largest fill source's particle count.
-double add_bulk_counts(const Scene& scene, MemoryCounts& n) {
+/// as a loose pile, half full) into n.
+void add_bulk_counts(const Scene& scene, MemoryCounts& n) {
   const ShotSettings& shot = scene.shot;
   const double dx = shot.dx;
-  double largest_fill = 0;
   for (const SourceDesc& src : scene.sources) {
     const double count = expected_source_particles(src, shot);
     const double h = spacing(src, shot);
@@ -309,12 +308,10 @@ double add_bulk_counts(const Scene& scene, MemoryCounts& n) {
       solid_blocks(vol, Vec3d::Constant(std::cbrt(vol)), dx, n.particle_blocks, n.grid_blocks);
     } else {
       n.fill_particles += count;
-      largest_fill = std::max(largest_fill, count);
       solid_blocks(shape_volume(src.shape), shape_extent(src.shape), dx, n.particle_blocks,
                    n.grid_blocks);
     }
   }
-  return largest_fill;
 }
 
 /// Per-shell velocity fields (shot.shell_velocities: per_shell) when two bodies share the
@@ -350,7 +347,7 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
     plastic = plastic || m.kind != MaterialKind::Elastic;
   const double per_particle = 2 * kVec3 + 2 * kMat3 + R + 2 + 4 + (plastic ? R : 0);
   out.bytes_per_particle = per_particle;
-  const double largest_fill = add_bulk_counts(scene, n);
+  add_bulk_counts(scene, n);
   ShellTotals t;
   for (std::size_t i = 0; i < scene.shells.size(); ++i) add_shell_memory(scene, i, n, t);
   const double fields_bytes = fields_memory(scene, t, n);
@@ -402,11 +399,10 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   out.step_scratch = std::max(
       {t.force_scratch + contact_scratch + implicit_grid + implicit_shells, growth, permute});
   // Built: the shells one by one, then contact and integrity, then the fill particles
-  // (each source's points in a vector of Vec3d, doubled by push_back, before they move
-  // into the particle arrays).
+  // (every source's points in a vector of Vec3d, up to doubled by push_back, all held
+  // while the particle arrays, allocated once at their final size, take them in).
   const double after_shells = t.shells_persistent + t.contact_bytes + integrity_bytes;
-  const double fill = after_shells + per_particle * n.fill_particles +
-                      std::max(2 * 24 * largest_fill, kMat3 * n.fill_particles);
+  const double fill = after_shells + per_particle * n.fill_particles + 2 * 24 * n.fill_particles;
   out.construction_bytes = std::max(t.construction, fill);
   return out;
 }

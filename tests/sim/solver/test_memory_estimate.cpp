@@ -111,7 +111,13 @@ TEST_CASE("memory estimate: the particle and grid arrays of a bulk scene", "[mem
   const SolverMemory est = estimate_solver_memory(s);
   SolverOptions so;
   so.serial = true;
+  const std::size_t base = heap_current();
+  reset_heap_peak();
   Solver solver(s, so);
+  // Both sources' points are held while the particle arrays take them in.
+  const double built_peak = static_cast<double>(heap_peak() - base);
+  CAPTURE(built_peak, est.construction_bytes);
+  CHECK(est.construction_bytes == Approx(built_peak).epsilon(0.25));
   solver.advance_to(1e-3);
   const ParticleSet& p = solver.particles();
   CHECK(est.counts.fill_particles == Approx(static_cast<double>(p.size())).epsilon(0.03));
