@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -16,6 +17,30 @@ inline std::vector<int> parse_int_list(const std::string& text) {
   std::string t;
   while (std::getline(ss, t, ',')) out.push_back(std::atoi(t.c_str()));
   return out;
+}
+
+/// One `--name value` option and what it sets.
+struct Option {
+  const char* name;
+  std::function<void(const char*)> set;
+};
+
+/// Parses `--name value` pairs against `options`; prints the offending argument (unknown,
+/// or without a value) and returns false on the first bad one.
+inline bool parse_options(int argc, char** argv, const std::vector<Option>& options) {
+  for (int i = 1; i < argc; i += 2) {
+    const std::string k = argv[i];
+    const Option* o = nullptr;
+    for (const Option& c : options)
+      if (k == c.name) o = &c;
+    if (o == nullptr || i + 1 >= argc) {
+      std::fprintf(stderr, "%s: %s %s\n", argv[0], o ? "no value for" : "unknown option",
+                   k.c_str());
+      return false;
+    }
+    o->set(argv[i + 1]);
+  }
+  return true;
 }
 
 /// Options of the sheet benchmarks: --vertices N --steps S --threads 1,2.

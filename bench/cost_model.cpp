@@ -107,19 +107,13 @@ void row(const char* sweep, const Scene& scene, double domain, const std::vector
 int main(int argc, char** argv) {
   std::vector<int> threads = {1, 2};
   double max_particles = 4.2e6, work = 8e6;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string k = argv[i];
-    if (k == "--threads")
-      threads = shellmpm_bench::parse_int_list(argv[i + 1]);
-    else if (k == "--max-particles")
-      max_particles = std::atof(argv[i + 1]);
-    else if (k == "--work")
-      work = std::atof(argv[i + 1]);
-    else {
-      std::fprintf(stderr, "cost_model: unknown option %s\n", k.c_str());
-      return 2;
-    }
-  }
+  using shellmpm_bench::parse_int_list;
+  if (!shellmpm_bench::parse_options(
+          argc, argv,
+          {{"--threads", [&](const char* v) { threads = parse_int_list(v); }},
+           {"--max-particles", [&](const char* v) { max_particles = std::atof(v); }},
+           {"--work", [&](const char* v) { work = std::atof(v); }}}))
+    return 2;
   if (threads.empty() || work <= 0) {
     std::fprintf(stderr, "cost_model: --threads needs a list, --work a positive number\n");
     return 2;

@@ -128,19 +128,13 @@ void run(const Case& c, int steps_per_frame, int frames, int threads) {
 int main(int argc, char** argv) {
   int frames = 6, explicit_frames = 2;
   std::vector<int> threads = {1, 2};
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string k = argv[i];
-    if (k == "--frames")
-      frames = std::atoi(argv[i + 1]);
-    else if (k == "--explicit-frames")
-      explicit_frames = std::atoi(argv[i + 1]);
-    else if (k == "--threads")
-      threads = shellmpm_bench::parse_int_list(argv[i + 1]);
-    else {
-      std::fprintf(stderr, "unknown option %s\n", k.c_str());
-      return 2;
-    }
-  }
+  using shellmpm_bench::parse_int_list;
+  if (!shellmpm_bench::parse_options(
+          argc, argv,
+          {{"--frames", [&](const char* v) { frames = std::atoi(v); }},
+           {"--explicit-frames", [&](const char* v) { explicit_frames = std::atoi(v); }},
+           {"--threads", [&](const char* v) { threads = parse_int_list(v); }}}))
+    return 2;
   for (const Case& c : {aluminium_strip(), steel_sheet()}) {
     Solver probe(c.scene);
     ShellObject& sh = *probe.shells()[0];

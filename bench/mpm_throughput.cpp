@@ -81,23 +81,15 @@ int main(int argc, char** argv) {
   std::string transfer = "apic";
   std::vector<int> threads = {1, 2};
   double dx = 1.0 / 128;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string k = argv[i];
-    if (k == "--particles")
-      target = std::atof(argv[i + 1]);
-    else if (k == "--steps")
-      steps = std::atoi(argv[i + 1]);
-    else if (k == "--transfer")
-      transfer = argv[i + 1];
-    else if (k == "--dx")
-      dx = std::atof(argv[i + 1]);
-    else if (k == "--threads")
-      threads = shellmpm_bench::parse_int_list(argv[i + 1]);
-    else {
-      std::fprintf(stderr, "unknown option %s\n", k.c_str());
-      return 2;
-    }
-  }
+  using shellmpm_bench::parse_int_list;
+  if (!shellmpm_bench::parse_options(
+          argc, argv,
+          {{"--particles", [&](const char* v) { target = std::atof(v); }},
+           {"--steps", [&](const char* v) { steps = std::atoi(v); }},
+           {"--transfer", [&](const char* v) { transfer = v; }},
+           {"--dx", [&](const char* v) { dx = std::atof(v); }},
+           {"--threads", [&](const char* v) { threads = parse_int_list(v); }}}))
+    return 2;
   const double cells = std::round(std::cbrt(target / 8.0));
   const Scene scene = cube_scene(cells, dx, transfer);
   std::printf(
