@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "bench/bench_args.h"
+#include "bench/bench_material.h"
 #include "bench/timed_advance.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
@@ -42,12 +43,7 @@ Scene cubes_scene(int count, double cells, double domain) {
   s.shot.cfl = 0.9;
   s.shot.dt_max = kDt;
   s.shot.gravity = Vec3d::Zero();  // nothing leaves its place during the timed steps
-  MaterialDesc m;
-  m.name = "jelly";
-  m.youngs_modulus = 1e4;
-  m.poisson_ratio = 0.3;
-  m.density = 1000;
-  s.materials.push_back(m);
+  s.materials.push_back(shellmpm_bench::jelly());
   const int per_side = static_cast<int>(std::lround(std::cbrt(static_cast<double>(count))));
   const double side = cells * kDx, pitch = domain / per_side;
   for (int i = 0; i < per_side; ++i)

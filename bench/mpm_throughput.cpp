@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bench/bench_args.h"
+#include "bench/bench_material.h"
 #include "bench/timed_advance.h"
 #include "sim/core/parallel.h"
 #include "sim/solver/solver.h"
@@ -30,12 +31,7 @@ Scene cube_scene(double cells_per_side, double dx, const std::string& transfer) 
   s.shot.cfl = 0.9;
   s.shot.dt_max = 1e-4;  // fixed step: the cube is soft enough that CFL never binds
   s.shot.transfer = transfer == "mls" ? Transfer::Mls : Transfer::Apic;
-  MaterialDesc m;
-  m.name = "jelly";
-  m.youngs_modulus = 1e4;
-  m.poisson_ratio = 0.3;
-  m.density = 1000;
-  s.materials.push_back(m);
+  s.materials.push_back(shellmpm_bench::jelly());
   SourceDesc src;
   src.material = 0;
   src.shape.kind = ShapeDesc::Kind::Box;
