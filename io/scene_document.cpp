@@ -11,6 +11,7 @@
 #include "io/scene_schema.h"
 #include "io/user_error.h"
 #include "io/yaml_key_near.h"
+#include "io/yaml_stray_comma.h"
 #include "sim/core/check.h"
 
 namespace shellmpm::scenefile {
@@ -21,6 +22,17 @@ namespace {
 YAML::Node load_yaml(const std::string& text, const std::string& where, const std::string& key,
                      bool from_file) {
   std::vector<YAML::Node> docs;
+  // yaml-cpp would never return on these (io/yaml_stray_comma.h).
+  if (const int bad = stray_flow_entry_line(text)) {
+    const int line = from_file ? bad : 0;
+    const std::string near = from_file ? yaml_key_near_line(text, bad) : std::string();
+    throw UserError(where, line, from_file ? std::string() : key,
+                    "YAML syntax error" +
+                        (!from_file     ? std::string()
+                         : near.empty() ? std::string(" (before the first key)")
+                                        : " in or after key " + near) +
+                        ": a ',' where a value should start (outside [...] or {...})");
+  }
   try {
     docs = YAML::LoadAll(text);
   } catch (const YAML::Exception& e) {

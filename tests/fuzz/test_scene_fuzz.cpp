@@ -272,6 +272,14 @@ void fuzz(int cases, bool cheap_runs_only, int run_every) {
     } else {
       why = "check exit " + std::to_string(ck.code) + ": " + ck.output.substr(0, 400);
     }
+    // SHELLMPM_FUZZ_KEEP with SHELLMPM_FUZZ_CASE=N also keeps case N whatever it gave (to
+    // replay a case that failed only on a slower build, such as the sanitizer's).
+    const char* only = std::getenv("SHELLMPM_FUZZ_CASE");
+    if (keep && only && std::atoi(only) == c) {
+      fs::create_directories(keep);
+      fs::copy_file(file, fs::path(keep) / ("case" + std::to_string(c) + ".yaml"),
+                    fs::copy_options::overwrite_existing);
+    }
     if (!why.empty()) {
       ++bad;
       UNSCOPED_INFO("case " << c << " (from " << seed.path.filename().string() << "): " << why);
