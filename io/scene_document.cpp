@@ -17,34 +17,34 @@
 namespace shellmpm::scenefile {
 namespace {
 
+/// A YAML syntax error at 1-based `line` of the text (0: unknown): for a file, at the file
+/// and line, with the key found from indentation (the text does not parse;
+/// io/yaml_key_near.h); for a --set value, at its key.
+[[noreturn]] void syntax_error(const std::string& text, const std::string& where,
+                               const std::string& key, bool from_file, int line,
+                               const std::string& what) {
+  if (!from_file || line <= 0) throw UserError(where, 0, key, "YAML syntax error: " + what);
+  const std::string near = yaml_key_near_line(text, line);
+  throw UserError(
+      where, line, "",
+      "YAML syntax error" +
+          (near.empty() ? std::string(" (before the first key)") : " in or after key " + near) +
+          ": " + what);
+}
+
 /// Parses YAML text into one yaml-cpp document; syntax errors are UserErrors at the file and
 /// line.
 YAML::Node load_yaml(const std::string& text, const std::string& where, const std::string& key,
                      bool from_file) {
-  std::vector<YAML::Node> docs;
   // yaml-cpp would never return on these (io/yaml_stray_comma.h).
-  if (const int bad = stray_flow_entry_line(text)) {
-    const int line = from_file ? bad : 0;
-    const std::string near = from_file ? yaml_key_near_line(text, bad) : std::string();
-    throw UserError(where, line, from_file ? std::string() : key,
-                    "YAML syntax error" +
-                        (!from_file     ? std::string()
-                         : near.empty() ? std::string(" (before the first key)")
-                                        : " in or after key " + near) +
-                        ": a ',' where a value should start (outside [...] or {...})");
-  }
+  if (const int bad = stray_flow_entry_line(text))
+    syntax_error(text, where, key, from_file, bad,
+                 "a ',' where a value should start (outside [...] or {...})");
+  std::vector<YAML::Node> docs;
   try {
     docs = YAML::LoadAll(text);
   } catch (const YAML::Exception& e) {
-    const int line = from_file && e.mark.line >= 0 ? e.mark.line + 1 : 0;
-    if (!from_file || line == 0) throw UserError(where, line, key, "YAML syntax error: " + e.msg);
-    // The text does not parse, so the key comes from indentation (io/yaml_key_near.h).
-    const std::string near = yaml_key_near_line(text, line);
-    throw UserError(
-        where, line, "",
-        "YAML syntax error" +
-            (near.empty() ? std::string(" (before the first key)") : " in or after key " + near) +
-            ": " + e.msg);
+    syntax_error(text, where, key, from_file, e.mark.line >= 0 ? e.mark.line + 1 : 0, e.msg);
   }
   if (docs.size() > 1) {
     throw UserError(where, 0, key,
