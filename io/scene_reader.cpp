@@ -204,24 +204,6 @@ void read_render(const DocNode& node, const Scene& scene, RenderSettings& rs) {
   r.finish();
 }
 
-/// The implicit integrator steps bulk materials and shells without contact (so far,
-/// docs/implicit.md): a scene with a shell in contact is refused at shot.integrator,
-/// never run half explicit.
-void check_integrator(const DocNode& shot_node, const Scene& scene) {
-  if (scene.shot.integrator != Integrator::Implicit) return;
-  for (std::size_t i = 0; i < scene.shells.size(); ++i) {
-    if (!shell_has_contact(scene, i)) continue;
-    MapReader r(shot_node, "shot", "shot", false);
-    fail(r.origin_of("integrator"), r.path_of("integrator"),
-         "implicit steps bulk materials and shells without contact only so far, and this "
-         "scene has shell '" +
-             scene.shells[i].name +
-             "' in contact (shells are in contact "
-             "when the scene has colliders, sources or another shell, unless contact: off); use "
-             "explicit, see docs/implicit.md");
-  }
-}
-
 Scene build_scene(const DocNode& root, const std::string& path) {
   Scene scene;
   scene.path = path;
@@ -237,7 +219,6 @@ Scene build_scene(const DocNode& root, const std::string& path) {
   read_preroll(*top.block("preroll"), scene.preroll);
   read_output(*top.block("output"), scene, scene.output);
   read_render(*top.block("render"), scene, scene.render);
-  check_integrator(*top.block("shot"), scene);
   top.finish();
   return scene;
 }

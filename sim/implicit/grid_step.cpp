@@ -11,7 +11,7 @@
 namespace shellmpm {
 namespace {
 
-using Pad = std::array<Vec3d, kPadNodes>;
+using Pad = PadD;
 
 /// A stencil node: offsets from the weights' base, padded-buffer index, weight.
 struct StencilNodeD {
@@ -58,6 +58,7 @@ class GridObjective final : public ImplicitObjective {
   double energy(const VecXd& u) override {
     scatter(u);
     double e = elastic(nullptr);
+    if (in_.shells) e += in_.shells->energy(vbuf_);
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
       if (!(m_[i] > 0)) continue;
       const Vec3d du = u.segment<3>(3 * i) - vhat_.segment<3>(3 * i);
@@ -102,6 +103,7 @@ class GridObjective final : public ImplicitObjective {
   void raw_gradient(const VecXd& u, VecXd& g) {
     scatter(u);
     elastic(&fbuf_);
+    if (in_.shells) in_.shells->gradient(vbuf_, fbuf_);
     g.setZero(size());
     gather(fbuf_, g);
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
@@ -112,7 +114,48 @@ class GridObjective final : public ImplicitObjective {
   }
 
  public:
-  void apply_preconditioner(const VecXd& r, VecXd& z) const override { z = r.cwiseQuotient(diag_); }
+  void apply_preconditioner(const VecXd& r, VecXd& z) const override {
+    z = r.cwiseQuotient(diag_);
+    if (!ldlt_) return;
+    VecXd rs(static_cast<Eigen::Index>(sdofs_.size()));
+    for (std::size_t k = 0; k < sdofs_.size(); ++k) rs[static_cast<Eigen::Index>(k)] = r[sdofs_[k]];
+    const VecXd zs = ldlt_->solve(rs);
+    for (std::size_t k = 0; k < sdofs_.size(); ++k) z[sdofs_[k]] = zs[static_cast<Eigen::Index>(k)];
+  }
+
+  /// With shells: their tangent on the nodes they reach, plus the nodes' mass and bulk
+  /// terms (diag_), factorised, or its diagonal into diag_ (block_jacobi).
+  void prepare_preconditioner(const VecXd& u) override {
+    if (!in_.shells) return;
+    ldlt_.reset();
+    scatter(u);
+    SparseMatrixD A;
+    in_.shells->tangent(vbuf_, sdofs_, A);
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(static_cast<std::size_t>(A.nonZeros()) + sdofs_.size());
+    for (Eigen::Index c = 0; c < A.outerSize(); ++c)
+      for (SparseMatrixD::InnerIterator it(A, c); it; ++it)
+        if (!fixed_[static_cast<std::size_t>(sdofs_[static_cast<std::size_t>(it.row())])] &&
+            !fixed_[static_cast<std::size_t>(sdofs_[static_cast<std::size_t>(it.col())])])
+          t.emplace_back(it.row(), it.col(), it.value());
+    for (std::size_t k = 0; k < sdofs_.size(); ++k) {
+      const Eigen::Index d = sdofs_[k];
+      // Mass and bulk terms; a fixed dof keeps 1 (its entries are projected out).
+      t.emplace_back(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k),
+                     fixed_[static_cast<std::size_t>(d)] ? 1.0 : base_diag_[d]);
+    }
+    SparseMatrixD P(A.rows(), A.cols());
+    P.setFromTriplets(t.begin(), t.end());
+    diag_ = base_diag_;
+    if (in_.factorise) {
+      ldlt_ = factorise_positive(P);
+      return;
+    }
+    for (std::size_t k = 0; k < sdofs_.size(); ++k) {
+      const auto kk = static_cast<Eigen::Index>(k);
+      diag_[sdofs_[k]] = std::max(P.coeff(kk, kk), base_diag_[sdofs_[k]]);
+    }
+  }
 
   void project(VecXd& d) const override {
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
@@ -195,7 +238,8 @@ class GridObjective final : public ImplicitObjective {
   void each_particle(std::size_t b, F&& f) const {
     const Vec3i corner = unpack_block(grid_.pblock_key[b]) * kBlockSize;
     for (std::uint32_t s = grid_.pblock_start[b]; s < grid_.pblock_start[b + 1]; ++s) {
-      const std::uint32_t q = grid_.order[s];
+      if (grid_.order[s] < in_.first_bulk) continue;  // a shell point
+      const std::uint32_t q = grid_.order[s] - in_.first_bulk;
       f(q, QuadraticWeights(grid_.grid_coord(in_.particles->x[q])), corner);
     }
   }
@@ -280,13 +324,16 @@ class GridObjective final : public ImplicitObjective {
         double& d = diag_[3 * i + a];
         d = m_[i] > 0 ? m_[i] + dt_ * dt_ * d : 1.0;
       }
+    base_diag_ = diag_;
   }
 
   const GridStepInput& in_;
   SparseGrid& grid_;
   double dt_;
   std::size_t nb_ = 0;
-  VecXd m_, vhat_, u0_, diag_;
+  VecXd m_, vhat_, u0_, diag_, base_diag_;
+  std::vector<Eigen::Index> sdofs_;  // the dofs the shells reach (prepare_preconditioner)
+  std::unique_ptr<SparseLdlt> ldlt_;
   std::vector<char> fixed_;
   std::vector<Vec3d> normal_;     // slip constraint normal per node (zero: none)
   std::vector<int> collider_of_;  // the collider of that constraint (-1: none)

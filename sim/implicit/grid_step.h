@@ -17,6 +17,10 @@
 // the normal impulse the constraint applied (the explicit collider stage takes it from the
 // approach speed, which the constraint has already stopped here).
 //
+// Shells in contact add their Kirchhoff-Love and contact energies at the moved control
+// points (grid_shells.h); the preconditioner then includes their tangent on the nodes they
+// reach.
+//
 // Everything is double: the constitutive models in ConstitutiveModelT<double>, the node
 // velocities, the sums. Per-node sums are gathered from per-particle-block buffers in the
 // grid's fixed order (sim/mpm/sparse_grid.h), so a solve is the same for any thread count.
@@ -26,6 +30,7 @@
 #include <vector>
 
 #include "sim/collider/collider.h"
+#include "sim/implicit/grid_shells.h"
 #include "sim/implicit/newton.h"
 #include "sim/mpm/constitutive.h"
 #include "sim/mpm/particles.h"
@@ -44,6 +49,13 @@ struct GridStepInput {
   int wall_cells = 3;
   bool mls = false;
   bool serial = false;
+  /// Shells in contact, their points binned in front of the bulk particles (bulk particle
+  /// q as first_bulk + q); null: none.
+  GridShellTerms* shells = nullptr;
+  std::uint32_t first_bulk = 0;
+  /// With shells: `factorised` factorises the tangent on the nodes the shells reach
+  /// (Jacobi elsewhere); `block_jacobi` keeps its diagonal.
+  bool factorise = true;
 };
 
 /// The objective of one grid step (for tests) and its start (v^n + dt g, constraints applied).

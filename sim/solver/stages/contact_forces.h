@@ -1,6 +1,7 @@
 // Stage "contact": Contact shells: pins prescribed for the step, contact particles placed from the
 // control points, and their tangential forces added to the control-point forces (which move into
-// the GridShell for the transfer).
+// the GridShell for the transfer). Implicit: pins and positions only (the forces are part of
+// the grid solve, implicit_grid).
 #pragma once
 #include "sim/solver/stages/stage.h"
 

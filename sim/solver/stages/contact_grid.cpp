@@ -5,7 +5,8 @@
 namespace shellmpm {
 
 bool ContactGridStage::needed(const Scene& s) {
-  return any_contact_shell(s);
+  // Implicit: the contact particles' normal forces are part of the grid solve.
+  return any_contact_shell(s) && s.shot.integrator == Integrator::Explicit;
 }
 
 void ContactGridStage::run(StepContext& c) {

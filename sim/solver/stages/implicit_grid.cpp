@@ -28,10 +28,24 @@ void ImplicitGridStage::run(StepContext& c) {
   in.wall_cells = kWallCells;
   in.mls = shot.transfer == Transfer::Mls;
   in.serial = c.opt.serial;
+  in.first_bulk = static_cast<std::uint32_t>(c.shell_table.size());
+  in.factorise = shot.implicit_preconditioner == ImplicitPreconditioner::Factorised;
+  if (kls_.size() != c.grid_shells.size()) {
+    kls_.resize(c.grid_shells.size());
+    for (std::size_t s = 0; s < kls_.size(); ++s)
+      kls_[s].kl = c.grid_shells[s].shell->double_kl(&kls_[s].coupling);
+  }
+  for (std::size_t s = 0; s < kls_.size(); ++s) c.grid_shells[s].shell->sync_double_kl(*kls_[s].kl);
   const NewtonOptions opt = newton_options(shot);
   double dt = c.dt;
   while (true) {
     for (Collider& col : c.colliders) col.begin_step(c.time, dt);
+    std::unique_ptr<GridShellTerms> shells;
+    if (!c.grid_shells.empty()) {
+      shells = std::make_unique<GridShellTerms>(c.grid, c.shell_table, c.grid_shells, kls_,
+                                                c.time, dt, c.opt.serial);
+      in.shells = shells.get();
+    }
     const NewtonReport rep = implicit_grid_step(in, dt, opt);
     c.implicit_frame.add(rep.iterations, rep.cg_iterations, rep.residual);
     if (rep.converged) break;
@@ -50,6 +64,8 @@ void ImplicitGridStage::run(StepContext& c) {
     }
   }
   c.dt = dt;
+  // Pinned control points: their velocity over the step actually taken.
+  for (GridShell& g : c.grid_shells) prescribe_pins(*g.shell, c.time, dt, g.held);
   c.apply_walls();
 }
 

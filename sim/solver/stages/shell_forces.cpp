@@ -5,8 +5,9 @@
 namespace shellmpm {
 
 bool ShellForcesStage::needed(const Scene& s) {
-  // Implicit: the shells without contact take their forces inside implicit_shells.
-  return s.shot.integrator == Integrator::Implicit ? any_contact_shell(s) : !s.shells.empty();
+  // Implicit: the shells take their forces inside implicit_shells (without contact) and
+  // implicit_grid (in contact).
+  return s.shot.integrator == Integrator::Explicit && !s.shells.empty();
 }
 
 void ShellForcesStage::run(StepContext& c) {
@@ -14,7 +15,6 @@ void ShellForcesStage::run(StepContext& c) {
   for (std::size_t i = 0; i < c.shells.size(); ++i) {
     ShellObject& sh = *c.shells[i];
     if (!c.contacts[i]) {
-      if (c.scene.shot.integrator == Integrator::Implicit) continue;
       sh.forces(c.scene.shot.gravity, c.shell_forces[i], c.opt.serial);
       continue;
     }

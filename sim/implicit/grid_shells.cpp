@@ -1,0 +1,387 @@
+#include "sim/implicit/grid_shells.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sim/contact/contact_energy.h"
+#include "sim/core/parallel.h"
+#include "sim/mpm/apic_stencil.h"
+#include "sim/mpm/bspline.h"
+
+namespace shellmpm {
+namespace {
+
+constexpr std::size_t kSiteGrain = 1024;
+
+/// Global node index (g kBlockNodes + n) of padded node (px, py, pz) of particle block b.
+std::size_t node_of(const SparseGrid& grid, std::size_t b, int px, int py, int pz) {
+  const int o = (px >= kBlockSize ? 4 : 0) + (py >= kBlockSize ? 2 : 0) + (pz >= kBlockSize ? 1 : 0);
+  const auto g = static_cast<std::size_t>(grid.pblock_nbr[b][o]);
+  return g * kBlockNodes +
+         block_node(px % kBlockSize, py % kBlockSize, pz % kBlockSize);
+}
+
+/// Calls f(table index) for the shell points binned in particle block b (they are binned
+/// in front of the bulk particles, and a block's entries ascend).
+template <class F>
+void each_shell_point(const SparseGrid& grid, std::size_t b, std::uint32_t count, F&& f) {
+  for (std::uint32_t s = grid.pblock_start[b]; s < grid.pblock_start[b + 1]; ++s) {
+    const std::uint32_t g = grid.order[s];
+    if (g >= count) break;
+    f(g);
+  }
+}
+
+Vec3i corner_of(const SparseGrid& grid, std::size_t b) {
+  return unpack_block(grid.pblock_key[b]) * kBlockSize;
+}
+
+}  // namespace
+
+GridShellTerms::GridShellTerms(const SparseGrid& grid, const ShellPointTable& table,
+                               const std::vector<GridShell>& shells,
+                               const std::vector<GridShellKl>& kls, double t, double dt,
+                               bool serial)
+    : grid_(grid), table_(table), dt_(dt), serial_(serial) {
+  sh_.resize(shells.size());
+  site_start_.assign(shells.size() + 1, 0);
+  for (std::size_t s = 0; s < shells.size(); ++s) {
+    Shell& S = sh_[s];
+    S.gs = &shells[s];
+    S.kl = &kls[s];
+    const ShellObject& sh = *shells[s].shell;
+    const std::size_t n = sh.size();
+    S.x0.resize(n);
+    for (std::size_t j = 0; j < n; ++j) S.x0[j] = sh.x[j].cast<double>();
+    S.X = S.x0;
+    S.v.assign(n, Vec3d::Zero());
+    sh.external_forces(Vec3d::Zero(), S.x0, S.fext);
+    sh.pin_targets(t, dt, S.held, S.target);
+    S.damping = sh.material().damping;
+    Eigen::AlignedBox<double, 3> box;
+    for (const Vec3d& p : S.x0) box.extend(p);
+    S.length = std::max(box.diagonal().norm(), 1e-12);
+    site_start_[s + 1] = site_start_[s] + static_cast<std::uint32_t>(shells[s].contact->num_sites());
+  }
+  // The contact particles' gradient weights from the node masses (as G2P computes them).
+  sites_.resize(site_start_.back());
+  a3_.assign(sites_.size(), Vec3d::Zero());
+  G3_.assign(sites_.size(), Vec3d::Zero());
+  const std::uint32_t nc = table.num_control_points();
+  const Real dx = static_cast<Real>(grid.dx());
+  parallel_for_each(
+      grid.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        const Vec3i bc = corner_of(grid, b);
+        each_shell_point(grid, b, static_cast<std::uint32_t>(table.size()), [&](std::uint32_t g) {
+          if (g < nc) return;
+          const std::uint32_t s = table.shell(g), p = table.local(g);
+          const ShellContact& c = *shells[s].contact;
+          Site& st = sites_[site_start_[s] + p];
+          st.shell = s;
+          st.local = p;
+          const QuadraticWeights W(grid.grid_coord(c.x[p]));
+          st.lx = W.base[0] - bc[0];
+          st.ly = W.base[1] - bc[1];
+          st.lz = W.base[2] - bc[2];
+          const SiteMoments sm = site_moments(W, dx, bc, [&](const StencilNode& nd) {
+            const std::size_t node = node_of(grid, b, nd.px, nd.py, nd.pz);
+            return grid.gblock_nodes[node / kBlockNodes][node % kBlockNodes].m;
+          });
+          st.any = sm.any;
+          if (!sm.any) return;
+          Real ga[27];
+          sm.dot(c.a3e[p], ga);
+          for (int k = 0; k < 27; ++k) st.ga[k] = dt * static_cast<double>(ga[k]);
+        });
+      },
+      serial);
+}
+
+void GridShellTerms::move(const std::vector<PadD>& vel) {
+  const std::uint32_t nc = table_.num_control_points();
+  parallel_for_each(
+      grid_.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        const Vec3i bc = corner_of(grid_, b);
+        each_shell_point(grid_, b, nc, [&](std::uint32_t g) {
+          Shell& S = sh_[table_.shell(g)];
+          const std::uint32_t j = table_.local(g);
+          const QuadraticWeights W(grid_.grid_coord(S.gs->shell->x[j]));
+          Vec3d v = Vec3d::Zero();
+          for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
+            v += static_cast<double>(nd.w) * vel[b][nd.pad()];
+          });
+          for (int a = 0; a < 3; ++a)
+            if (S.held[j] & (1u << a)) {
+              S.X[j][a] = S.target[j][a];
+              v[a] = (S.target[j][a] - S.x0[j][a]) / dt_;
+            } else {
+              S.X[j][a] = S.x0[j][a] + dt_ * v[a];
+            }
+          S.v[j] = v;
+        });
+      },
+      serial_);
+}
+
+void GridShellTerms::advance_sites(const std::vector<PadD>& vel) {
+  parallel_for(
+      sites_.size(), kSiteGrain,
+      [&](std::size_t b0, std::size_t b1) {
+        for (std::size_t i = b0; i < b1; ++i) a3_[i] = sh_[sites_[i].shell].gs->contact->a3e[sites_[i].local].cast<double>();
+      },
+      serial_);
+  const std::uint32_t nc = table_.num_control_points();
+  parallel_for_each(
+      grid_.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        each_shell_point(grid_, b, static_cast<std::uint32_t>(table_.size()), [&](std::uint32_t g) {
+          if (g < nc) return;
+          const std::size_t i = site_start_[table_.shell(g)] + table_.local(g);
+          const Site& st = sites_[i];
+          if (!st.any) return;
+          Vec3d d = Vec3d::Zero();
+          int n = 0;
+          for (int x = 0; x < 3; ++x)
+            for (int y = 0; y < 3; ++y)
+              for (int z = 0; z < 3; ++z, ++n)
+                d += st.ga[n] * vel[b][pad_node(st.lx + x, st.ly + y, st.lz + z)];
+          a3_[i] += d;
+        });
+      },
+      serial_);
+}
+
+double GridShellTerms::evaluate(bool grad) {
+  double e = 0;
+  for (std::size_t s = 0; s < sh_.size(); ++s) {
+    Shell& S = sh_[s];
+    const ShellContact& c = *S.gs->contact;
+    const ShellObject& sh = *S.gs->shell;
+    const std::size_t n = S.X.size();
+    if (grad) S.f.assign(n, Vec3d::Zero());
+    e += S.kl->kl->energy(S.X.data(), grad ? S.f.data() : nullptr, serial_).total;
+    // Contact particles: energy, and their dpsi/da_beta (G1, G2) and dpsi/da3E.
+    const std::uint32_t s0 = site_start_[s];
+    const std::size_t ns = c.num_sites();
+    std::vector<Mat3d> G(grad ? ns : 0);
+    const ContactParams& cp = c.params();
+    e += ordered_reduce(ns, kSiteGrain, serial_, 0.0, [&](std::size_t p) {
+      const Vec3d ref = S.X[c.idx[c.off[p]]];
+      Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
+      for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
+        const Vec3d d = S.X[c.idx[k]] - ref;
+        a1 += static_cast<double>(c.N1[k]) * d;
+        a2 += static_cast<double>(c.N2[k]) * d;
+      }
+      const double V = static_cast<double>(c.volume[p]);
+      Mat3d Gp;
+      const double psi = contact_gradient<double>(a1, a2, a3_[s0 + p], cp, grad ? &Gp : nullptr);
+      if (grad) {
+        G[p] = V * Gp;
+        G3_[s0 + p] = G[p].col(2);
+      }
+      return V * psi;
+    });
+    // Damping and loads on the free components.
+    for (std::size_t j = 0; j < n; ++j) {
+      const double m = static_cast<double>(sh.mass[j]);
+      for (int a = 0; a < 3; ++a) {
+        if (S.held[j] & (1u << a)) continue;
+        const double v = S.v[j][a];
+        e += dt_ * (0.5 * S.damping * m * v * v - S.fext[j][a] * v);
+      }
+    }
+    if (!grad) continue;
+    S.dX.assign(n, Vec3d::Zero());
+    for (std::size_t p = 0; p < ns; ++p)
+      for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k)
+        S.dX[c.idx[k]] += static_cast<double>(c.N1[k]) * G[p].col(0) +
+                          static_cast<double>(c.N2[k]) * G[p].col(1);
+    for (std::size_t j = 0; j < n; ++j) {
+      const double m = static_cast<double>(sh.mass[j]);
+      for (int a = 0; a < 3; ++a)
+        S.dX[j][a] = (S.held[j] & (1u << a))
+                         ? 0.0
+                         : S.dX[j][a] - S.f[j][a] + S.damping * m * S.v[j][a] - S.fext[j][a];
+    }
+  }
+  return e;
+}
+
+double GridShellTerms::energy(const std::vector<PadD>& vel) {
+  move(vel);
+  advance_sites(vel);
+  return evaluate(false);
+}
+
+double GridShellTerms::gradient(const std::vector<PadD>& vel, std::vector<PadD>& grad) {
+  move(vel);
+  advance_sites(vel);
+  const double e = evaluate(true);
+  const std::uint32_t nc = table_.num_control_points();
+  parallel_for_each(
+      grid_.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        const Vec3i bc = corner_of(grid_, b);
+        each_shell_point(grid_, b, static_cast<std::uint32_t>(table_.size()), [&](std::uint32_t g) {
+          if (g < nc) {
+            const Shell& S = sh_[table_.shell(g)];
+            const std::uint32_t j = table_.local(g);
+            const Vec3d d = dt_ * S.dX[j];
+            const QuadraticWeights W(grid_.grid_coord(S.gs->shell->x[j]));
+            for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
+              grad[b][nd.pad()] += static_cast<double>(nd.w) * d;
+            });
+            return;
+          }
+          const std::size_t i = site_start_[table_.shell(g)] + table_.local(g);
+          const Site& st = sites_[i];
+          if (!st.any) return;
+          int n = 0;
+          for (int x = 0; x < 3; ++x)
+            for (int y = 0; y < 3; ++y)
+              for (int z = 0; z < 3; ++z, ++n)
+                grad[b][pad_node(st.lx + x, st.ly + y, st.lz + z)] += st.ga[n] * G3_[i];
+        });
+      },
+      serial_);
+  return e;
+}
+
+void GridShellTerms::contact_forces(std::size_t s, const std::vector<Vec3d>& X,
+                                    std::vector<Vec3d>& f) const {
+  const ShellContact& c = *sh_[s].gs->contact;
+  const std::uint32_t s0 = site_start_[s];
+  for (std::size_t p = 0; p < c.num_sites(); ++p) {
+    const Vec3d ref = X[c.idx[c.off[p]]];
+    Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
+    for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
+      const Vec3d d = X[c.idx[k]] - ref;
+      a1 += static_cast<double>(c.N1[k]) * d;
+      a2 += static_cast<double>(c.N2[k]) * d;
+    }
+    Mat3d G;
+    contact_gradient<double>(a1, a2, a3_[s0 + p], c.params(), &G);
+    G *= static_cast<double>(c.volume[p]);
+    for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k)
+      f[c.idx[k]] -= static_cast<double>(c.N1[k]) * G.col(0) + static_cast<double>(c.N2[k]) * G.col(1);
+  }
+}
+
+void GridShellTerms::tangent(const std::vector<PadD>& vel, std::vector<Eigen::Index>& dofs,
+                             SparseMatrixD& A) {
+  move(vel);
+  advance_sites(vel);
+  // Rows: node dofs; collected per shell as (global dof, control dof, weight).
+  struct Entry {
+    Eigen::Index row;
+    int col;
+    double w;
+  };
+  std::vector<std::vector<Entry>> W(sh_.size());
+  std::vector<std::vector<int>> dof_of(sh_.size());
+  std::vector<int> ndofs(sh_.size(), 0);
+  for (std::size_t s = 0; s < sh_.size(); ++s) {
+    const Shell& S = sh_[s];
+    const ShellObject& sh = *S.gs->shell;
+    dof_of[s].assign(3 * sh.size(), -1);
+    for (std::size_t j = 0; j < sh.size(); ++j)
+      for (int a = 0; a < 3; ++a)
+        if (!(S.held[j] & (1u << a)) && sh.mass[j] > 0) dof_of[s][3 * j + a] = ndofs[s]++;
+  }
+  const std::uint32_t nc = table_.num_control_points();
+  for (std::size_t b = 0; b < grid_.num_particle_blocks(); ++b) {
+    const Vec3i bc = corner_of(grid_, b);
+    each_shell_point(grid_, b, nc, [&](std::uint32_t g) {
+      const std::size_t s = table_.shell(g);
+      const std::uint32_t j = table_.local(g);
+      const QuadraticWeights Wq(grid_.grid_coord(sh_[s].gs->shell->x[j]));
+      for_each_stencil_node(Wq, bc, [&](const StencilNode& nd) {
+        const auto node = static_cast<Eigen::Index>(node_of(grid_, b, nd.px, nd.py, nd.pz));
+        for (int a = 0; a < 3; ++a) {
+          const int col = dof_of[s][3 * j + a];
+          if (col >= 0) W[s].push_back({3 * node + a, col, static_cast<double>(nd.w)});
+        }
+      });
+    });
+  }
+  // Contact particles' stiffness on the diagonal: V psi'' (dt g_n . a3E)^2 with psi'' the
+  // larger of the shear's gamma and the compression's 2 k_c (1 - s3) at vel.
+  std::vector<std::pair<Eigen::Index, double>> diag;
+  for (std::size_t b = 0; b < grid_.num_particle_blocks(); ++b)
+    each_shell_point(grid_, b, static_cast<std::uint32_t>(table_.size()), [&](std::uint32_t g) {
+      if (g < nc) return;
+      const std::size_t i = site_start_[table_.shell(g)] + table_.local(g);
+      const Site& st = sites_[i];
+      if (!st.any) return;
+      const ShellContact& c = *sh_[st.shell].gs->contact;
+      const ContactParams& cp = c.params();
+      const std::vector<Vec3d>& X = sh_[st.shell].X;
+      const Vec3d ref = X[c.idx[c.off[st.local]]];
+      Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
+      for (std::uint32_t k = c.off[st.local]; k < c.off[st.local + 1]; ++k) {
+        a1 += static_cast<double>(c.N1[k]) * (X[c.idx[k]] - ref);
+        a2 += static_cast<double>(c.N2[k]) * (X[c.idx[k]] - ref);
+      }
+      const double s3 = contact_frame<double>(a1, a2, a3_[i]).s[2];
+      const double k = static_cast<double>(c.volume[st.local]) *
+                       std::max(cp.gamma, 2 * cp.kc * std::max(0.0, 1 - s3));
+      int n = 0;
+      for (int x = 0; x < 3; ++x)
+        for (int y = 0; y < 3; ++y)
+          for (int z = 0; z < 3; ++z, ++n) {
+            if (st.ga[n] == 0) continue;
+            const auto node = static_cast<Eigen::Index>(
+                node_of(grid_, b, st.lx + x, st.ly + y, st.lz + z));
+            for (int a = 0; a < 3; ++a) diag.emplace_back(3 * node + a, k * st.ga[n] * st.ga[n]);
+          }
+    });
+  dofs.clear();
+  for (const auto& w : W)
+    for (const Entry& e : w) dofs.push_back(e.row);
+  for (const auto& d : diag) dofs.push_back(d.first);
+  std::sort(dofs.begin(), dofs.end());
+  dofs.erase(std::unique(dofs.begin(), dofs.end()), dofs.end());
+  const auto local = [&](Eigen::Index row) {
+    return static_cast<int>(std::lower_bound(dofs.begin(), dofs.end(), row) - dofs.begin());
+  };
+  const auto rows = static_cast<Eigen::Index>(dofs.size());
+  A.resize(rows, rows);
+  A.setZero();
+  for (std::size_t s = 0; s < sh_.size(); ++s) {
+    if (ndofs[s] == 0) continue;
+    const Shell& S = sh_[s];
+    const std::size_t n = S.X.size();
+    std::vector<char> movable(n, 0);
+    for (std::size_t k = 0; k < 3 * n; ++k)
+      if (dof_of[s][k] >= 0) movable[k / 3] = 1;
+    const std::vector<std::vector<int>>& coupling = S.kl->coupling;
+    const std::vector<std::vector<int>> groups = colour_points(coupling, movable);
+    const PointForceFn forces = [this, s](const std::vector<Vec3d>& p, std::vector<Vec3d>& f) {
+      sh_[s].kl->kl->energy(p.data(), f.data(), serial_);
+      contact_forces(s, p, f);
+    };
+    std::vector<Vec3d> f0(n, Vec3d::Zero());
+    forces(S.X, f0);
+    const SparseMatrixD K =
+        fd_stiffness(forces, S.X, f0, dof_of[s], ndofs[s], coupling, groups, 1e-8 * S.length);
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(W[s].size());
+    for (const Entry& e : W[s]) t.emplace_back(local(e.row), e.col, e.w);
+    SparseMatrixD Ws(rows, ndofs[s]);
+    Ws.setFromTriplets(t.begin(), t.end());
+    const SparseMatrixD KWt = K * SparseMatrixD(Ws.transpose());
+    A += SparseMatrixD(Ws * KWt);
+  }
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(diag.size());
+  for (const auto& d : diag) t.emplace_back(local(d.first), local(d.first), d.second);
+  SparseMatrixD D(rows, rows);
+  D.setFromTriplets(t.begin(), t.end());  // sums duplicates
+  A *= dt_ * dt_;
+  A += D;
+}
+
+}  // namespace shellmpm

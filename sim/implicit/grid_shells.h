@@ -1,0 +1,97 @@
+// The shells in contact in the implicit grid step (grid_step.h): their control points and
+// contact particles live on the grid, so their energies are functions of the node
+// velocities u. With the control point j's weights w_nj (at x_j^n) and the contact
+// particle p's gradient weights g_np (the mass-weighted least-squares gradient of
+// shell_transfer.h, at its position x_p^n):
+//   X_j(u)   = x_j^n + dt sum_n w_nj u_n              (a pinned component: its pin pose)
+//   a3E_p(u) = a3E_p^n + dt sum_n (g_np . a3E_p^n) u_n
+//   E_shells(u) = Psi_KL(X) + sum_p V_p psi(a_1(X), a_2(X), a3E_p)
+//                 + sum_j (dt c m_j |v_j|^2 / 2 - dt f_ext,j . v_j),  v_j = (X_j - x_j^n) / dt,
+// the Kirchhoff-Love energy at the moved control points, the contact particles' QR
+// energy with a3E advanced by the same linearisation G2P applies (supplement sections 2
+// and 4-5), mass damping c and the external loads (pressure, point loads; gravity acts on
+// the nodes). The friction return mapping and denting follow the step (their stages), as
+// in the explicit path. Everything is double; the weights are the float ones G2P uses.
+//
+// Preconditioner: on the nodes the shells' control points reach, the tangent
+// dt^2 W^T K W (K the control points' stiffness, Kirchhoff-Love and the contact
+// particles' tangential part, by finite differences of the forces: fd_stiffness.h; W the
+// weights w_nj) plus the contact particles' normal stiffness on the diagonal; the caller
+// adds the nodes' mass and bulk terms and factorises it, or keeps its diagonal.
+#pragma once
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "sim/contact/shell_transfer.h"
+#include "sim/shell/fd_stiffness.h"
+#include "sim/shell/kirchhoff_love.h"
+
+namespace shellmpm {
+
+using PadD = std::array<Vec3d, kPadNodes>;
+
+/// A grid shell's double Kirchhoff-Love copy (ShellObject::double_kl) and its coupling.
+struct GridShellKl {
+  std::unique_ptr<KirchhoffLoveShellT<double>> kl;
+  std::vector<std::vector<int>> coupling;
+};
+
+class GridShellTerms {
+ public:
+  /// grid: binned with the shells' points in front (table), after P2G (node masses);
+  /// kls: per grid shell, synced with its plastic state. t, dt: the step.
+  GridShellTerms(const SparseGrid& grid, const ShellPointTable& table,
+                 const std::vector<GridShell>& shells, const std::vector<GridShellKl>& kls,
+                 double t, double dt, bool serial);
+
+  /// E_shells at the node velocities in the particle blocks' padded buffers.
+  double energy(const std::vector<PadD>& vel);
+  /// Adds dE_shells/du to the particle blocks' padded buffers (summed per node by the
+  /// caller); returns E_shells.
+  double gradient(const std::vector<PadD>& vel, std::vector<PadD>& grad);
+
+  /// The node dofs the shells reach, 3 (g kBlockNodes + n) + a for grid block g, node n,
+  /// ascending, and the tangent dt^2 (W^T K W + contact normal diagonal) on them at vel.
+  void tangent(const std::vector<PadD>& vel, std::vector<Eigen::Index>& dofs, SparseMatrixD& A);
+
+  /// Where the control points end (for tests): X(u) of grid shell s.
+  const std::vector<Vec3d>& moved(std::size_t s) const { return sh_[s].X; }
+
+ private:
+  struct Shell {
+    const GridShell* gs = nullptr;
+    const GridShellKl* kl = nullptr;
+    std::vector<Vec3d> x0, X, v, f, fext, dX;  ///< start, moved, velocity, forces, loads, dE/dX
+    std::vector<std::uint8_t> held;
+    std::vector<Vec3d> target;
+    double damping = 0;
+    double length = 1;
+  };
+  /// A contact particle's stencil: 27 coefficients dt (g_n . a3E^n), or none.
+  struct Site {
+    std::uint32_t shell, local;
+    int lx, ly, lz;  ///< stencil base in its particle block's padded buffer
+    bool any;
+    double ga[27];
+  };
+  /// X of every control point from vel; v_j kept in V_.
+  void move(const std::vector<PadD>& vel);
+  /// a3E(u) of every contact particle from vel.
+  void advance_sites(const std::vector<PadD>& vel);
+  /// Energy at the moved state; with `grad`, dE/dX into Shell::dX and dE/da3E into G3_.
+  double evaluate(bool grad);
+  /// Contact tangential forces at X with the given a3E (for fd_stiffness), added to f.
+  void contact_forces(std::size_t s, const std::vector<Vec3d>& X, std::vector<Vec3d>& f) const;
+
+  const SparseGrid& grid_;
+  const ShellPointTable& table_;
+  double dt_;
+  bool serial_;
+  std::vector<Shell> sh_;
+  std::vector<Site> sites_;
+  std::vector<std::uint32_t> site_start_;  ///< per shell: its first entry in sites_
+  std::vector<Vec3d> a3_, G3_;             ///< per site: a3E(u), V dpsi/da3E
+};
+
+}  // namespace shellmpm
