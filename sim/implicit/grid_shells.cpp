@@ -1,5 +1,6 @@
 #include "sim/implicit/grid_shells.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 
@@ -307,41 +308,36 @@ void GridShellTerms::tangent(const std::vector<PadD>& vel, std::vector<Eigen::In
       });
     });
   }
-  // Contact particles' stiffness on the diagonal: V psi'' (dt g_n . a3E)^2 with psi'' the
-  // larger of the shear's gamma and the compression's 2 k_c (1 - s3) at vel.
-  std::vector<std::pair<Eigen::Index, double>> diag;
+  // The contact particles' a3E rows: a3E(u) = a3E^n + Ga^T u, Ga (node dof, 3 p + a) =
+  // dt g_n . a3E^n (per shell, site-local columns).
+  struct GaEntry {
+    Eigen::Index row;
+    int col;
+    double v;
+  };
+  std::vector<std::vector<GaEntry>> Ga(sh_.size());
   for (std::size_t b = 0; b < grid_.num_particle_blocks(); ++b)
     each_shell_point(grid_, b, static_cast<std::uint32_t>(table_.size()), [&](std::uint32_t g) {
       if (g < nc) return;
       const std::size_t i = site_start_[table_.shell(g)] + table_.local(g);
       const Site& st = sites_[i];
       if (!st.any) return;
-      const ShellContact& c = *sh_[st.shell].gs->contact;
-      const ContactParams& cp = c.params();
-      const std::vector<Vec3d>& X = sh_[st.shell].X;
-      const Vec3d ref = X[c.idx[c.off[st.local]]];
-      Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
-      for (std::uint32_t k = c.off[st.local]; k < c.off[st.local + 1]; ++k) {
-        a1 += static_cast<double>(c.N1[k]) * (X[c.idx[k]] - ref);
-        a2 += static_cast<double>(c.N2[k]) * (X[c.idx[k]] - ref);
-      }
-      const double s3 = contact_frame<double>(a1, a2, a3_[i]).s[2];
-      const double k = static_cast<double>(c.volume[st.local]) *
-                       std::max(cp.gamma, 2 * cp.kc * std::max(0.0, 1 - s3));
       int n = 0;
       for (int x = 0; x < 3; ++x)
         for (int y = 0; y < 3; ++y)
           for (int z = 0; z < 3; ++z, ++n) {
             if (st.ga[n] == 0) continue;
-            const auto node = static_cast<Eigen::Index>(
-                node_of(grid_, b, st.lx + x, st.ly + y, st.lz + z));
-            for (int a = 0; a < 3; ++a) diag.emplace_back(3 * node + a, k * st.ga[n] * st.ga[n]);
+            const auto node =
+                static_cast<Eigen::Index>(node_of(grid_, b, st.lx + x, st.ly + y, st.lz + z));
+            for (int a = 0; a < 3; ++a)
+              Ga[st.shell].push_back({3 * node + a, static_cast<int>(3 * st.local + a), st.ga[n]});
           }
     });
   dofs.clear();
   for (const auto& w : W)
     for (const Entry& e : w) dofs.push_back(e.row);
-  for (const auto& d : diag) dofs.push_back(d.first);
+  for (const auto& ga : Ga)
+    for (const GaEntry& e : ga) dofs.push_back(e.row);
   std::sort(dofs.begin(), dofs.end());
   dofs.erase(std::unique(dofs.begin(), dofs.end()), dofs.end());
   const auto local = [&](Eigen::Index row) {
@@ -351,9 +347,72 @@ void GridShellTerms::tangent(const std::vector<PadD>& vel, std::vector<Eigen::In
   A.resize(rows, rows);
   A.setZero();
   for (std::size_t s = 0; s < sh_.size(); ++s) {
-    if (ndofs[s] == 0) continue;
     const Shell& S = sh_[s];
+    const ShellContact& c = *S.gs->contact;
     const std::size_t n = S.X.size();
+    const auto ns = static_cast<Eigen::Index>(c.num_sites());
+    // Weights (node dof, control dof), scaled by dt: dX/du = dt W^T.
+    std::vector<Eigen::Triplet<double>> t;
+    t.reserve(W[s].size());
+    for (const Entry& e : W[s]) t.emplace_back(local(e.row), e.col, dt_ * e.w);
+    SparseMatrixD Wd(rows, ndofs[s]);
+    Wd.setFromTriplets(t.begin(), t.end());
+    t.clear();
+    for (const GaEntry& e : Ga[s]) t.emplace_back(local(e.row), e.col, e.v);
+    SparseMatrixD G(rows, 3 * ns);
+    G.setFromTriplets(t.begin(), t.end());
+    // Each contact particle's Hessian in (a1, a2, a3E), by central differences of its
+    // gradient, made positive semi-definite; its a3E-a3E block and its coupling to the
+    // control points (the a1, a2 blocks are in K below, with a3E held).
+    std::vector<Eigen::Triplet<double>> txa, taa;
+    for (Eigen::Index p = 0; p < ns; ++p) {
+      const Vec3d ref = S.X[c.idx[c.off[p]]];
+      Eigen::Matrix<double, 9, 1> y;
+      Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
+      for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
+        a1 += static_cast<double>(c.N1[k]) * (S.X[c.idx[k]] - ref);
+        a2 += static_cast<double>(c.N2[k]) * (S.X[c.idx[k]] - ref);
+      }
+      y << a1, a2, a3_[site_start_[s] + static_cast<std::size_t>(p)];
+      const auto grad = [&](const Eigen::Matrix<double, 9, 1>& q) {
+        Mat3d Gq;
+        contact_gradient<double>(Vec3d(q.segment<3>(0)), Vec3d(q.segment<3>(3)),
+                                 Vec3d(q.segment<3>(6)), c.params(), &Gq);
+        return Eigen::Matrix<double, 9, 1>(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(Gq.data()));
+      };
+      Eigen::Matrix<double, 9, 9> H;
+      const double h = 1e-6 * std::max({a1.norm(), a2.norm(), 1.0});
+      for (int k = 0; k < 9; ++k) {
+        Eigen::Matrix<double, 9, 1> yp = y, ym = y;
+        yp[k] += h;
+        ym[k] -= h;
+        H.col(k) = (grad(yp) - grad(ym)) / (2 * h);
+      }
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> es(0.5 * (H + H.transpose()));
+      H = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() *
+          es.eigenvectors().transpose();
+      H *= static_cast<double>(c.volume[p]);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) taa.emplace_back(3 * p + i, 3 * p + j, H(6 + i, 6 + j));
+      // d^2 psi / dX_k dA3E = sum_beta dN_k/dxi_beta d^2 psi / da_beta da3E.
+      for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
+        const Mat3d B = static_cast<double>(c.N1[k]) * H.block<3, 3>(0, 6) +
+                        static_cast<double>(c.N2[k]) * H.block<3, 3>(3, 6);
+        for (int i = 0; i < 3; ++i) {
+          const int row = dof_of[s][3 * c.idx[k] + i];
+          if (row < 0) continue;
+          for (int j = 0; j < 3; ++j) txa.emplace_back(row, 3 * p + j, B(i, j));
+        }
+      }
+    }
+    SparseMatrixD Kaa(3 * ns, 3 * ns), Kxa(ndofs[s], 3 * ns);
+    Kaa.setFromTriplets(taa.begin(), taa.end());
+    Kxa.setFromTriplets(txa.begin(), txa.end());
+    A += SparseMatrixD(G * SparseMatrixD(Kaa * SparseMatrixD(G.transpose())));
+    if (ndofs[s] == 0) continue;
+    const SparseMatrixD cross = Wd * SparseMatrixD(Kxa * SparseMatrixD(G.transpose()));
+    A += cross;
+    A += SparseMatrixD(cross.transpose());
     std::vector<char> movable(n, 0);
     for (std::size_t k = 0; k < 3 * n; ++k)
       if (dof_of[s][k] >= 0) movable[k / 3] = 1;
@@ -367,21 +426,8 @@ void GridShellTerms::tangent(const std::vector<PadD>& vel, std::vector<Eigen::In
     forces(S.X, f0);
     const SparseMatrixD K =
         fd_stiffness(forces, S.X, f0, dof_of[s], ndofs[s], coupling, groups, 1e-8 * S.length);
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(W[s].size());
-    for (const Entry& e : W[s]) t.emplace_back(local(e.row), e.col, e.w);
-    SparseMatrixD Ws(rows, ndofs[s]);
-    Ws.setFromTriplets(t.begin(), t.end());
-    const SparseMatrixD KWt = K * SparseMatrixD(Ws.transpose());
-    A += SparseMatrixD(Ws * KWt);
+    A += SparseMatrixD(Wd * SparseMatrixD(K * SparseMatrixD(Wd.transpose())));
   }
-  std::vector<Eigen::Triplet<double>> t;
-  t.reserve(diag.size());
-  for (const auto& d : diag) t.emplace_back(local(d.first), local(d.first), d.second);
-  SparseMatrixD D(rows, rows);
-  D.setFromTriplets(t.begin(), t.end());  // sums duplicates
-  A *= dt_ * dt_;
-  A += D;
 }
 
 }  // namespace shellmpm

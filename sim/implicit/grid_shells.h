@@ -16,7 +16,8 @@
 // Preconditioner: on the nodes the shells' control points reach, the tangent
 // dt^2 W^T K W (K the control points' stiffness, Kirchhoff-Love and the contact
 // particles' tangential part, by finite differences of the forces: fd_stiffness.h; W the
-// weights w_nj) plus the contact particles' normal stiffness on the diagonal; the caller
+// weights w_nj) and the contact particles' a3E terms (their Hessians, made positive
+// semi-definite, through the gradient weights and the control points); the caller
 // adds the nodes' mass and bulk terms and factorises it, or keeps its diagonal.
 #pragma once
 #include <array>

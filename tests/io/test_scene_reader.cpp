@@ -1097,7 +1097,7 @@ TEST_CASE("schema entries are consistent", "[scene]") {
   }
 }
 
-TEST_CASE("scene: shot.integrator implicit, its dt_max default and its scope", "[scene]") {
+TEST_CASE("scene: shot.integrator implicit and its dt_max default", "[scene]") {
   const std::string shells =
       "shell_materials: [{name: m}]\n"
       "shells:\n"
@@ -1117,10 +1117,9 @@ TEST_CASE("scene: shot.integrator implicit, its dt_max default and its scope", "
     CHECK(e.shot.integrator == Integrator::Explicit);
     CHECK(e.shot.dt_max == 1e-2);
   }
-  // Shells in contact (a collider) are not stepped implicitly yet: refused, not run half
-  // explicit.
-  expect_error(head + shells +
-                   "colliders:\n  - {shape: {type: plane, point: [0, -1, 0], normal: [0, 1, 0]}}\n",
-               5, "shot.integrator",
-               {"implicit steps bulk materials and shells without contact only", "'s'"});
+  // Shells in contact (a collider) are stepped implicitly too, on the grid.
+  const Scene c = parse_scene(
+      head + shells + "colliders:\n  - {shape: {type: plane, point: [0, -1, 0], normal: [0, 1, 0]}}\n",
+      "scenes/ok.yaml", {});
+  CHECK(c.shot.integrator == Integrator::Implicit);
 }
