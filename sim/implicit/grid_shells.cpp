@@ -271,57 +271,46 @@ void GridShellTerms::contact_forces(std::size_t s, const std::vector<Vec3d>& X,
   }
 }
 
-void GridShellTerms::tangent(const std::vector<PadD>& vel, std::vector<Eigen::Index>& dofs,
-                             SparseMatrixD& A) {
+void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseMatrixD& J,
+                           SparseMatrixD& K) {
   move(vel);
   advance_sites(vel);
-  // Rows: node dofs; collected per shell as (global dof, control dof, weight).
-  struct Entry {
-    Eigen::Index row;
-    int col;
-    double w;
-  };
-  std::vector<std::vector<Entry>> W(sh_.size());
+  // The joint space: per shell its free control-point components, then 3 per contact
+  // particle (its a3E).
   std::vector<std::vector<int>> dof_of(sh_.size());
-  std::vector<int> ndofs(sh_.size(), 0);
+  std::vector<int> first(sh_.size() + 1, 0);
+  std::vector<int> nfree(sh_.size(), 0);
   for (std::size_t s = 0; s < sh_.size(); ++s) {
     const Shell& S = sh_[s];
     const ShellObject& sh = *S.gs->shell;
     dof_of[s].assign(3 * sh.size(), -1);
     for (std::size_t j = 0; j < sh.size(); ++j)
       for (int a = 0; a < 3; ++a)
-        if (!(S.held[j] & (1u << a)) && sh.mass[j] > 0) dof_of[s][3 * j + a] = ndofs[s]++;
+        if (!(S.held[j] & (1u << a)) && sh.mass[j] > 0) dof_of[s][3 * j + a] = nfree[s]++;
+    first[s + 1] = first[s] + nfree[s] + 3 * static_cast<int>(S.gs->contact->num_sites());
   }
+  // J: dX/du = dt w (control rows), da3E/du = dt g . a3E^n (contact particle rows).
+  std::vector<Eigen::Triplet<double>> tj;
   const std::uint32_t nc = table_.num_control_points();
   for (std::size_t b = 0; b < grid_.num_particle_blocks(); ++b) {
     const Vec3i bc = corner_of(grid_, b);
-    each_shell_point(grid_, b, nc, [&](std::uint32_t g) {
+    each_shell_point(grid_, b, static_cast<std::uint32_t>(table_.size()), [&](std::uint32_t g) {
       const std::size_t s = table_.shell(g);
       const std::uint32_t j = table_.local(g);
-      const QuadraticWeights Wq(grid_.grid_coord(sh_[s].gs->shell->x[j]));
-      for_each_stencil_node(Wq, bc, [&](const StencilNode& nd) {
-        const auto node = static_cast<Eigen::Index>(node_of(grid_, b, nd.px, nd.py, nd.pz));
-        for (int a = 0; a < 3; ++a) {
-          const int col = dof_of[s][3 * j + a];
-          if (col >= 0) W[s].push_back({3 * node + a, col, static_cast<double>(nd.w)});
-        }
-      });
-    });
-  }
-  // The contact particles' a3E rows: a3E(u) = a3E^n + Ga^T u, Ga (node dof, 3 p + a) =
-  // dt g_n . a3E^n (per shell, site-local columns).
-  struct GaEntry {
-    Eigen::Index row;
-    int col;
-    double v;
-  };
-  std::vector<std::vector<GaEntry>> Ga(sh_.size());
-  for (std::size_t b = 0; b < grid_.num_particle_blocks(); ++b)
-    each_shell_point(grid_, b, static_cast<std::uint32_t>(table_.size()), [&](std::uint32_t g) {
-      if (g < nc) return;
-      const std::size_t i = site_start_[table_.shell(g)] + table_.local(g);
-      const Site& st = sites_[i];
+      if (g < nc) {
+        const QuadraticWeights Wq(grid_.grid_coord(sh_[s].gs->shell->x[j]));
+        for_each_stencil_node(Wq, bc, [&](const StencilNode& nd) {
+          const auto node = static_cast<Eigen::Index>(node_of(grid_, b, nd.px, nd.py, nd.pz));
+          for (int a = 0; a < 3; ++a) {
+            const int d = dof_of[s][3 * j + a];
+            if (d >= 0) tj.emplace_back(first[s] + d, 3 * node + a, dt_ * static_cast<double>(nd.w));
+          }
+        });
+        return;
+      }
+      const Site& st = sites_[site_start_[s] + j];
       if (!st.any) return;
+      const int row = first[s] + nfree[s] + 3 * static_cast<int>(j);
       int n = 0;
       for (int x = 0; x < 3; ++x)
         for (int y = 0; y < 3; ++y)
@@ -329,51 +318,31 @@ void GridShellTerms::tangent(const std::vector<PadD>& vel, std::vector<Eigen::In
             if (st.ga[n] == 0) continue;
             const auto node =
                 static_cast<Eigen::Index>(node_of(grid_, b, st.lx + x, st.ly + y, st.lz + z));
-            for (int a = 0; a < 3; ++a)
-              Ga[st.shell].push_back({3 * node + a, static_cast<int>(3 * st.local + a), st.ga[n]});
+            for (int a = 0; a < 3; ++a) tj.emplace_back(row + a, 3 * node + a, st.ga[n]);
           }
     });
-  dofs.clear();
-  for (const auto& w : W)
-    for (const Entry& e : w) dofs.push_back(e.row);
-  for (const auto& ga : Ga)
-    for (const GaEntry& e : ga) dofs.push_back(e.row);
-  std::sort(dofs.begin(), dofs.end());
-  dofs.erase(std::unique(dofs.begin(), dofs.end()), dofs.end());
-  const auto local = [&](Eigen::Index row) {
-    return static_cast<int>(std::lower_bound(dofs.begin(), dofs.end(), row) - dofs.begin());
-  };
-  const auto rows = static_cast<Eigen::Index>(dofs.size());
-  A.resize(rows, rows);
-  A.setZero();
+  }
+  J.resize(first.back(), N);
+  J.setFromTriplets(tj.begin(), tj.end());
+  // K: the Kirchhoff-Love and contact Hessian in (X, a3E).
+  std::vector<Eigen::Triplet<double>> tk;
   for (std::size_t s = 0; s < sh_.size(); ++s) {
     const Shell& S = sh_[s];
     const ShellContact& c = *S.gs->contact;
     const std::size_t n = S.X.size();
-    const auto ns = static_cast<Eigen::Index>(c.num_sites());
-    // Weights (node dof, control dof), scaled by dt: dX/du = dt W^T.
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(W[s].size());
-    for (const Entry& e : W[s]) t.emplace_back(local(e.row), e.col, dt_ * e.w);
-    SparseMatrixD Wd(rows, ndofs[s]);
-    Wd.setFromTriplets(t.begin(), t.end());
-    t.clear();
-    for (const GaEntry& e : Ga[s]) t.emplace_back(local(e.row), e.col, e.v);
-    SparseMatrixD G(rows, 3 * ns);
-    G.setFromTriplets(t.begin(), t.end());
+    const int a0 = first[s] + nfree[s];
     // Each contact particle's Hessian in (a1, a2, a3E), by central differences of its
-    // gradient, made positive semi-definite; its a3E-a3E block and its coupling to the
-    // control points (the a1, a2 blocks are in K below, with a3E held).
-    std::vector<Eigen::Triplet<double>> txa, taa;
-    for (Eigen::Index p = 0; p < ns; ++p) {
+    // gradient, made positive semi-definite: its a3E-a3E block and its coupling to the
+    // control points (the a1, a2 blocks enter through the forces' differences below).
+    for (std::size_t p = 0; p < c.num_sites(); ++p) {
       const Vec3d ref = S.X[c.idx[c.off[p]]];
-      Eigen::Matrix<double, 9, 1> y;
       Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
       for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
         a1 += static_cast<double>(c.N1[k]) * (S.X[c.idx[k]] - ref);
         a2 += static_cast<double>(c.N2[k]) * (S.X[c.idx[k]] - ref);
       }
-      y << a1, a2, a3_[site_start_[s] + static_cast<std::size_t>(p)];
+      Eigen::Matrix<double, 9, 1> y;
+      y << a1, a2, a3_[site_start_[s] + p];
       const auto grad = [&](const Eigen::Matrix<double, 9, 1>& q) {
         Mat3d Gq;
         contact_gradient<double>(Vec3d(q.segment<3>(0)), Vec3d(q.segment<3>(3)),
@@ -392,27 +361,24 @@ void GridShellTerms::tangent(const std::vector<PadD>& vel, std::vector<Eigen::In
       H = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() *
           es.eigenvectors().transpose();
       H *= static_cast<double>(c.volume[p]);
+      const int pr = a0 + 3 * static_cast<int>(p);
       for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) taa.emplace_back(3 * p + i, 3 * p + j, H(6 + i, 6 + j));
-      // d^2 psi / dX_k dA3E = sum_beta dN_k/dxi_beta d^2 psi / da_beta da3E.
+        for (int j = 0; j < 3; ++j) tk.emplace_back(pr + i, pr + j, H(6 + i, 6 + j));
+      // d^2 psi / dX_k da3E = sum_beta dN_k/dxi_beta d^2 psi / da_beta da3E.
       for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
         const Mat3d B = static_cast<double>(c.N1[k]) * H.block<3, 3>(0, 6) +
                         static_cast<double>(c.N2[k]) * H.block<3, 3>(3, 6);
         for (int i = 0; i < 3; ++i) {
-          const int row = dof_of[s][3 * c.idx[k] + i];
-          if (row < 0) continue;
-          for (int j = 0; j < 3; ++j) txa.emplace_back(row, 3 * p + j, B(i, j));
+          const int d = dof_of[s][3 * c.idx[k] + i];
+          if (d < 0) continue;
+          for (int j = 0; j < 3; ++j) {
+            tk.emplace_back(first[s] + d, pr + j, B(i, j));
+            tk.emplace_back(pr + j, first[s] + d, B(i, j));
+          }
         }
       }
     }
-    SparseMatrixD Kaa(3 * ns, 3 * ns), Kxa(ndofs[s], 3 * ns);
-    Kaa.setFromTriplets(taa.begin(), taa.end());
-    Kxa.setFromTriplets(txa.begin(), txa.end());
-    A += SparseMatrixD(G * SparseMatrixD(Kaa * SparseMatrixD(G.transpose())));
-    if (ndofs[s] == 0) continue;
-    const SparseMatrixD cross = Wd * SparseMatrixD(Kxa * SparseMatrixD(G.transpose()));
-    A += cross;
-    A += SparseMatrixD(cross.transpose());
+    if (nfree[s] == 0) continue;
     std::vector<char> movable(n, 0);
     for (std::size_t k = 0; k < 3 * n; ++k)
       if (dof_of[s][k] >= 0) movable[k / 3] = 1;
@@ -424,9 +390,61 @@ void GridShellTerms::tangent(const std::vector<PadD>& vel, std::vector<Eigen::In
     };
     std::vector<Vec3d> f0(n, Vec3d::Zero());
     forces(S.X, f0);
-    const SparseMatrixD K =
-        fd_stiffness(forces, S.X, f0, dof_of[s], ndofs[s], coupling, groups, 1e-8 * S.length);
-    A += SparseMatrixD(Wd * SparseMatrixD(K * SparseMatrixD(Wd.transpose())));
+    const SparseMatrixD Kx =
+        fd_stiffness(forces, S.X, f0, dof_of[s], nfree[s], coupling, groups, 1e-8 * S.length);
+    for (Eigen::Index col = 0; col < Kx.outerSize(); ++col)
+      for (SparseMatrixD::InnerIterator it(Kx, col); it; ++it)
+        tk.emplace_back(first[s] + static_cast<int>(it.row()), first[s] + static_cast<int>(it.col()),
+                        it.value());
+  }
+  K.resize(first.back(), first.back());
+  K.setFromTriplets(tk.begin(), tk.end());
+}
+
+void GridShellTerms::prepare(const std::vector<PadD>& vel, const VecXd& minv) {
+  SparseMatrixD K;
+  joint(vel, minv.size(), J_, K);
+  // S~ = the absolute row sums of J M^-1 J^T (>= it, so the preconditioner stays positive
+  // definite), and the factor of K + S~^-1.
+  const VecXd colsum = SparseMatrixD(J_.cwiseAbs().transpose()) * VecXd::Ones(J_.rows());
+  const VecXd s = J_.cwiseAbs() * minv.cwiseProduct(colsum);
+  const double floor = 1e-12 * std::max(s.maxCoeff(), 1e-300);
+  sinv_ = s.cwiseMax(floor).cwiseInverse();
+  SparseMatrixD A = K;
+  for (Eigen::Index k = 0; k < A.rows(); ++k) A.coeffRef(k, k) += sinv_[k];
+  ldlt_ = factorise_positive(A);
+}
+
+void GridShellTerms::apply(const VecXd& r, const VecXd& minv, VecXd& z) const {
+  z = minv.cwiseProduct(r);
+  if (!ldlt_) return;
+  const VecXd y = J_ * z;
+  const VecXd w = sinv_.cwiseProduct(y);
+  const VecXd t = ldlt_->solve(w);
+  const VecXd yy = w - sinv_.cwiseProduct(t);
+  z -= minv.cwiseProduct(J_.transpose() * yy);
+}
+
+void GridShellTerms::add_diagonal(const std::vector<PadD>& vel, VecXd& diag) {
+  SparseMatrixD J, K;
+  joint(vel, diag.size(), J, K);
+  const SparseMatrixD KJ = K * J;
+  for (Eigen::Index col = 0; col < J.outerSize(); ++col) {
+    double d = 0;
+    SparseMatrixD::InnerIterator a(J, col), b(KJ, col);
+    // sum_i J_ik (K J)_ik over the rows both columns hold.
+    while (a && b) {
+      if (a.row() < b.row()) {
+        ++a;
+      } else if (b.row() < a.row()) {
+        ++b;
+      } else {
+        d += a.value() * b.value();
+        ++a;
+        ++b;
+      }
+    }
+    diag[col] += d;
   }
 }
 

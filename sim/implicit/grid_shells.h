@@ -13,18 +13,18 @@
 // the nodes). The friction return mapping and denting follow the step (their stages), as
 // in the explicit path. Everything is double; the weights are the float ones G2P uses.
 //
-// Preconditioner: on the nodes the shells' control points reach, the tangent
-// dt^2 W^T K W (K the control points' stiffness, Kirchhoff-Love and the contact
-// particles' tangential part, by finite differences of the forces: fd_stiffness.h; W the
-// weights w_nj) and the contact particles' a3E terms (their Hessians, made positive
-// semi-definite, through the gradient weights and the control points); the caller
-// adds the nodes' mass and bulk terms and factorises it, or keeps its diagonal.
+// Preconditioner (prepare): the Hessian of the shells' terms in their own unknowns, the
+// control points and the contact particles' a3E (Kirchhoff-Love and contact tangential
+// stiffness by finite differences of the forces, fd_stiffness.h; each contact particle's
+// Hessian by differences of its gradient, made positive semi-definite), brought to the
+// nodes by Woodbury's identity with a lumped coupling (see prepare).
 #pragma once
 #include <array>
 #include <memory>
 #include <vector>
 
 #include "sim/contact/shell_transfer.h"
+#include "sim/implicit/newton.h"
 #include "sim/shell/fd_stiffness.h"
 #include "sim/shell/kirchhoff_love.h"
 
@@ -52,9 +52,21 @@ class GridShellTerms {
   /// caller); returns E_shells.
   double gradient(const std::vector<PadD>& vel, std::vector<PadD>& grad);
 
-  /// The node dofs the shells reach, 3 (g kBlockNodes + n) + a for grid block g, node n,
-  /// ascending, and the tangent dt^2 (W^T K W + contact normal diagonal) on them at vel.
-  void tangent(const std::vector<PadD>& vel, std::vector<Eigen::Index>& dofs, SparseMatrixD& A);
+  /// The preconditioner's shell part at vel (objective dofs 3 (g kBlockNodes + n) + a;
+  /// minv: the inverse of the rest of the objective's diagonal, the nodes' mass and bulk
+  /// terms, 0 on constrained dofs). With the joint unknowns y = (the free control-point
+  /// components, every contact particle's a3E), y = J u + const, and K their Hessian
+  /// (Kirchhoff-Love and contact, made positive definite), the Hessian is
+  /// M + J^T K J; by Woodbury its inverse is M^-1 - M^-1 J^T (K^-1 + S)^-1 J M^-1 with
+  /// S = J M^-1 J^T. S is replaced by S~, its absolute row sums (S~ >= S, so the
+  /// approximation stays positive definite), and (K^-1 + S~)^-1 applied as
+  /// S~^-1 - S~^-1 (K + S~^-1)^-1 S~^-1: one sparse factorisation of the shells' own size
+  /// and sparsity, where the tangent on the grid nodes fills in nearly dense.
+  void prepare(const std::vector<PadD>& vel, const VecXd& minv);
+  /// z = P^-1 r (after prepare).
+  void apply(const VecXd& r, const VecXd& minv, VecXd& z) const;
+  /// Adds diag(J^T K J) at vel to diag (the block_jacobi preconditioner).
+  void add_diagonal(const std::vector<PadD>& vel, VecXd& diag);
 
   /// Where the control points end (for tests): X(u) of grid shell s.
   const std::vector<Vec3d>& moved(std::size_t s) const { return sh_[s].X; }
@@ -82,6 +94,8 @@ class GridShellTerms {
   void advance_sites(const std::vector<PadD>& vel);
   /// Energy at the moved state; with `grad`, dE/dX into Shell::dX and dE/da3E into G3_.
   double evaluate(bool grad);
+  /// J and K at vel (see prepare); N: the objective's size.
+  void joint(const std::vector<PadD>& vel, Eigen::Index N, SparseMatrixD& J, SparseMatrixD& K);
   /// Contact tangential forces at X with the given a3E (for fd_stiffness), added to f.
   void contact_forces(std::size_t s, const std::vector<Vec3d>& X, std::vector<Vec3d>& f) const;
 
@@ -93,6 +107,9 @@ class GridShellTerms {
   std::vector<Site> sites_;
   std::vector<std::uint32_t> site_start_;  ///< per shell: its first entry in sites_
   std::vector<Vec3d> a3_, G3_;             ///< per site: a3E(u), V dpsi/da3E
+  SparseMatrixD J_;                        ///< prepare's J
+  VecXd sinv_;                             ///< prepare's S~^-1
+  std::unique_ptr<SparseLdlt> ldlt_;       ///< prepare's factor of K + S~^-1
 };
 
 }  // namespace shellmpm

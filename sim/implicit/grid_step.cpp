@@ -115,46 +115,28 @@ class GridObjective final : public ImplicitObjective {
 
  public:
   void apply_preconditioner(const VecXd& r, VecXd& z) const override {
-    z = r.cwiseQuotient(diag_);
-    if (!ldlt_) return;
-    VecXd rs(static_cast<Eigen::Index>(sdofs_.size()));
-    for (std::size_t k = 0; k < sdofs_.size(); ++k) rs[static_cast<Eigen::Index>(k)] = r[sdofs_[k]];
-    const VecXd zs = ldlt_->solve(rs);
-    for (std::size_t k = 0; k < sdofs_.size(); ++k) z[sdofs_[k]] = zs[static_cast<Eigen::Index>(k)];
-  }
-
-  /// With shells: their tangent on the nodes they reach, plus the nodes' mass and bulk
-  /// terms (diag_), factorised, or its diagonal into diag_ (block_jacobi).
-  void prepare_preconditioner(const VecXd& u) override {
-    if (!in_.shells) return;
-    ldlt_.reset();
-    scatter(u);
-    SparseMatrixD A;
-    in_.shells->tangent(vbuf_, sdofs_, A);
-    std::vector<Eigen::Triplet<double>> t;
-    t.reserve(static_cast<std::size_t>(A.nonZeros()) + sdofs_.size());
-    for (Eigen::Index c = 0; c < A.outerSize(); ++c)
-      for (SparseMatrixD::InnerIterator it(A, c); it; ++it)
-        if (!fixed_[static_cast<std::size_t>(sdofs_[static_cast<std::size_t>(it.row())])] &&
-            !fixed_[static_cast<std::size_t>(sdofs_[static_cast<std::size_t>(it.col())])])
-          t.emplace_back(it.row(), it.col(), it.value());
-    for (std::size_t k = 0; k < sdofs_.size(); ++k) {
-      const Eigen::Index d = sdofs_[k];
-      // Mass and bulk terms; a fixed dof keeps 1 (its entries are projected out).
-      t.emplace_back(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k),
-                     fixed_[static_cast<std::size_t>(d)] ? 1.0 : base_diag_[d]);
-    }
-    SparseMatrixD P(A.rows(), A.cols());
-    P.setFromTriplets(t.begin(), t.end());
-    diag_ = base_diag_;
-    if (in_.factorise) {
-      ldlt_ = factorise_positive(P);
+    if (shells_ready_) {
+      in_.shells->apply(r, minv_, z);
       return;
     }
-    for (std::size_t k = 0; k < sdofs_.size(); ++k) {
-      const auto kk = static_cast<Eigen::Index>(k);
-      diag_[sdofs_[k]] = std::max(P.coeff(kk, kk), base_diag_[sdofs_[k]]);
+    z = r.cwiseQuotient(diag_);
+  }
+
+  /// With shells: their part of the Hessian (grid_shells.h, prepare), or with
+  /// block_jacobi its diagonal added to the nodes' own.
+  void prepare_preconditioner(const VecXd& u) override {
+    if (!in_.shells) return;
+    scatter(u);
+    if (in_.factorise) {
+      minv_ = base_diag_.cwiseInverse();
+      for (Eigen::Index k = 0; k < size(); ++k)
+        if (fixed_[static_cast<std::size_t>(k)]) minv_[k] = 0;
+      in_.shells->prepare(vbuf_, minv_);
+      shells_ready_ = true;
+      return;
     }
+    diag_ = base_diag_;
+    in_.shells->add_diagonal(vbuf_, diag_);
   }
 
   void project(VecXd& d) const override {
@@ -331,9 +313,8 @@ class GridObjective final : public ImplicitObjective {
   SparseGrid& grid_;
   double dt_;
   std::size_t nb_ = 0;
-  VecXd m_, vhat_, u0_, diag_, base_diag_;
-  std::vector<Eigen::Index> sdofs_;  // the dofs the shells reach (prepare_preconditioner)
-  std::unique_ptr<SparseLdlt> ldlt_;
+  VecXd m_, vhat_, u0_, diag_, base_diag_, minv_;
+  bool shells_ready_ = false;  // the shells' preconditioner is prepared
   std::vector<char> fixed_;
   std::vector<Vec3d> normal_;     // slip constraint normal per node (zero: none)
   std::vector<int> collider_of_;  // the collider of that constraint (-1: none)
