@@ -334,3 +334,56 @@ TEST_CASE("implicit grid with shells: a cloth dropped on a ball follows the expl
   CHECK(big.mean_y < 0.40);
   CHECK(big.max_depth < 0.5 * 0.04);
 }
+
+namespace {
+
+struct Dent {
+  double plastic_work = 0, depth = 0, settled_depth = 0, seconds = 0;
+  int steps = 0;
+};
+
+/// scenes/steel_dent.yaml to its end (the ball has withdrawn), then the sheet's permanent
+/// dent: the static shape of its plastic state with the clamps (no gravity, no ball).
+Dent steel_dent(Integrator integrator, double dt_max = 1.0 / 240) {
+  Scene s = read_scene(std::string(SHELLMPM_SOURCE_DIR) + "/scenes/steel_dent.yaml");
+  s.shot.integrator = integrator;
+  if (integrator == Integrator::Implicit) s.shot.dt_max = dt_max;
+  Solver solver(s);
+  Dent d;
+  for (int f = 2; f <= 3; ++f) {
+    const FrameStats fs = solver.advance_to((f - 1) / 240.0);
+    d.plastic_work = fs.shell_plastic_work;
+    d.steps += fs.substeps;
+    CHECK(!fs.integrity.failed());
+  }
+  ShellObject& sh = *solver.shells()[0];
+  double low = 1e9;
+  for (const Vec3& x : sh.x) low = std::min(low, static_cast<double>(x.y()));
+  d.depth = 0.1 - low;
+  const StaticSolveResult r = sh.settle(Vec3d::Zero(), 2.0 / 240, 1e-6, 2000, false);
+  CHECK(r.converged);
+  low = 1e9;
+  for (const Vec3& x : sh.x) low = std::min(low, static_cast<double>(x.y()));
+  d.settled_depth = 0.1 - low;
+  return d;
+}
+
+}  // namespace
+
+// Issue 14 asks for the implicit dent within 5% of the explicit one. Not met yet (2026-12-03:
+// settled dent 9.1 mm explicit, 2.2 mm implicit at 1/240 s, 4.9 mm at 1/2400 s, 3.0 mm at
+// 1e-4 s; docs/implicit.md), so this test checks what holds: both integrators dent the
+// sheet, and both runs stay clean.
+TEST_CASE("implicit grid with shells: the steel sheet struck by a ball at 10 m/s dents with "
+          "both integrators",
+          "[implicit][slow]") {
+  const Dent e = steel_dent(Integrator::Explicit);
+  const Dent i = steel_dent(Integrator::Implicit);
+  INFO("explicit: " << e.steps << " steps, plastic work " << e.plastic_work << " J, depth "
+                    << e.depth << " m, settled " << e.settled_depth << " m; implicit: " << i.steps
+                    << " steps, " << i.plastic_work << " J, depth " << i.depth << " m, settled "
+                    << i.settled_depth << " m");
+  CHECK(e.settled_depth > 5e-3);  // it dents
+  CHECK(i.settled_depth > 1e-3);
+  CHECK(i.steps < e.steps / 500);
+}
