@@ -16,10 +16,10 @@ constexpr std::size_t kSiteGrain = 1024;
 
 /// Global node index (g kBlockNodes + n) of padded node (px, py, pz) of particle block b.
 std::size_t node_of(const SparseGrid& grid, std::size_t b, int px, int py, int pz) {
-  const int o = (px >= kBlockSize ? 4 : 0) + (py >= kBlockSize ? 2 : 0) + (pz >= kBlockSize ? 1 : 0);
+  const int o =
+      (px >= kBlockSize ? 4 : 0) + (py >= kBlockSize ? 2 : 0) + (pz >= kBlockSize ? 1 : 0);
   const auto g = static_cast<std::size_t>(grid.pblock_nbr[b][o]);
-  return g * kBlockNodes +
-         block_node(px % kBlockSize, py % kBlockSize, pz % kBlockSize);
+  return g * kBlockNodes + block_node(px % kBlockSize, py % kBlockSize, pz % kBlockSize);
 }
 
 /// Calls f(table index) for the shell points binned in particle block b (they are binned
@@ -62,7 +62,8 @@ GridShellTerms::GridShellTerms(const SparseGrid& grid, const ShellPointTable& ta
     Eigen::AlignedBox<double, 3> box;
     for (const Vec3d& p : S.x0) box.extend(p);
     S.length = std::max(box.diagonal().norm(), 1e-12);
-    site_start_[s + 1] = site_start_[s] + static_cast<std::uint32_t>(shells[s].contact->num_sites());
+    site_start_[s + 1] =
+        site_start_[s] + static_cast<std::uint32_t>(shells[s].contact->num_sites());
   }
   // The contact particles' gradient weights from the node masses (as G2P computes them).
   sites_.resize(site_start_.back());
@@ -130,7 +131,8 @@ void GridShellTerms::advance_sites(const std::vector<PadD>& vel) {
   parallel_for(
       sites_.size(), kSiteGrain,
       [&](std::size_t b0, std::size_t b1) {
-        for (std::size_t i = b0; i < b1; ++i) a3_[i] = sh_[sites_[i].shell].gs->contact->a3e[sites_[i].local].cast<double>();
+        for (std::size_t i = b0; i < b1; ++i)
+          a3_[i] = sh_[sites_[i].shell].gs->contact->a3e[sites_[i].local].cast<double>();
       },
       serial_);
   const std::uint32_t nc = table_.num_control_points();
@@ -198,8 +200,8 @@ double GridShellTerms::evaluate(bool grad) {
     S.dX.assign(n, Vec3d::Zero());
     for (std::size_t p = 0; p < ns; ++p)
       for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k)
-        S.dX[c.idx[k]] += static_cast<double>(c.N1[k]) * G[p].col(0) +
-                          static_cast<double>(c.N2[k]) * G[p].col(1);
+        S.dX[c.idx[k]] +=
+            static_cast<double>(c.N1[k]) * G[p].col(0) + static_cast<double>(c.N2[k]) * G[p].col(1);
     for (std::size_t j = 0; j < n; ++j) {
       const double m = static_cast<double>(sh.mass[j]);
       for (int a = 0; a < 3; ++a)
@@ -267,7 +269,8 @@ void GridShellTerms::contact_forces(std::size_t s, const std::vector<Vec3d>& X,
     contact_gradient<double>(a1, a2, a3_[s0 + p], c.params(), &G);
     G *= static_cast<double>(c.volume[p]);
     for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k)
-      f[c.idx[k]] -= static_cast<double>(c.N1[k]) * G.col(0) + static_cast<double>(c.N2[k]) * G.col(1);
+      f[c.idx[k]] -=
+          static_cast<double>(c.N1[k]) * G.col(0) + static_cast<double>(c.N2[k]) * G.col(1);
   }
 }
 
@@ -303,7 +306,8 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
           const auto node = static_cast<Eigen::Index>(node_of(grid_, b, nd.px, nd.py, nd.pz));
           for (int a = 0; a < 3; ++a) {
             const int d = dof_of[s][3 * j + a];
-            if (d >= 0) tj.emplace_back(first[s] + d, 3 * node + a, dt_ * static_cast<double>(nd.w));
+            if (d >= 0)
+              tj.emplace_back(first[s] + d, 3 * node + a, dt_ * static_cast<double>(nd.w));
           }
         });
         return;
@@ -347,7 +351,8 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
         Mat3d Gq;
         contact_gradient<double>(Vec3d(q.segment<3>(0)), Vec3d(q.segment<3>(3)),
                                  Vec3d(q.segment<3>(6)), c.params(), &Gq);
-        return Eigen::Matrix<double, 9, 1>(Eigen::Map<const Eigen::Matrix<double, 9, 1>>(Gq.data()));
+        return Eigen::Matrix<double, 9, 1>(
+            Eigen::Map<const Eigen::Matrix<double, 9, 1>>(Gq.data()));
       };
       Eigen::Matrix<double, 9, 9> H;
       const double h = 1e-6 * std::max({a1.norm(), a2.norm(), 1.0});
@@ -394,8 +399,8 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
         fd_stiffness(forces, S.X, f0, dof_of[s], nfree[s], coupling, groups, 1e-8 * S.length);
     for (Eigen::Index col = 0; col < Kx.outerSize(); ++col)
       for (SparseMatrixD::InnerIterator it(Kx, col); it; ++it)
-        tk.emplace_back(first[s] + static_cast<int>(it.row()), first[s] + static_cast<int>(it.col()),
-                        it.value());
+        tk.emplace_back(first[s] + static_cast<int>(it.row()),
+                        first[s] + static_cast<int>(it.col()), it.value());
   }
   K.resize(first.back(), first.back());
   K.setFromTriplets(tk.begin(), tk.end());

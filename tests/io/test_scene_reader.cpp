@@ -1119,7 +1119,8 @@ TEST_CASE("scene: shot.integrator implicit and its dt_max default", "[scene]") {
   }
   // Shells in contact (a collider) are stepped implicitly too, on the grid.
   const Scene c = parse_scene(
-      head + shells + "colliders:\n  - {shape: {type: plane, point: [0, -1, 0], normal: [0, 1, 0]}}\n",
+      head + shells +
+          "colliders:\n  - {shape: {type: plane, point: [0, -1, 0], normal: [0, 1, 0]}}\n",
       "scenes/ok.yaml", {});
   CHECK(c.shot.integrator == Integrator::Implicit);
 }

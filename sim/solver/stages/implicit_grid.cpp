@@ -42,8 +42,8 @@ void ImplicitGridStage::run(StepContext& c) {
     for (Collider& col : c.colliders) col.begin_step(c.time, dt);
     std::unique_ptr<GridShellTerms> shells;
     if (!c.grid_shells.empty()) {
-      shells = std::make_unique<GridShellTerms>(c.grid, c.shell_table, c.grid_shells, kls_,
-                                                c.time, dt, c.opt.serial);
+      shells = std::make_unique<GridShellTerms>(c.grid, c.shell_table, c.grid_shells, kls_, c.time,
+                                                dt, c.opt.serial);
       in.shells = shells.get();
     }
     const NewtonReport rep = implicit_grid_step(in, dt, opt);

@@ -63,14 +63,13 @@ sources:
     cp.kc = 1e5;
     cp.gamma = 4e4;
     cp.friction = 0.3;
-    contact =
-        std::make_unique<ShellContact>(shell->basis(), shell->rest, mat.thickness, 3, cp);
+    contact = std::make_unique<ShellContact>(shell->basis(), shell->rest, mat.thickness, 3, cp);
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(-1, 1);
     for (std::size_t j = 0; j < shell->size(); ++j) {
       const Vec3 r = shell->x[j];
-      shell->x[j] += Vec3(u(rng), u(rng), u(rng)) * Real(0.003) +
-                     Vec3(0, Real(0.2) * r.x() * r.x(), 0);
+      shell->x[j] +=
+          Vec3(u(rng), u(rng), u(rng)) * Real(0.003) + Vec3(0, Real(0.2) * r.x() * r.x(), 0);
       shell->v[j] = Vec3(u(rng), u(rng), u(rng)) * Real(0.3);
     }
     for (auto& a : contact->a3e) {
@@ -160,9 +159,10 @@ TEST_CASE("implicit grid with shells: the gradient matches finite differences", 
   }
 }
 
-TEST_CASE("implicit grid with shells: both preconditioners are symmetric positive definite and "
-          "give the same step",
-          "[implicit]") {
+TEST_CASE(
+    "implicit grid with shells: both preconditioners are symmetric positive definite and "
+    "give the same step",
+    "[implicit]") {
   const double dt = 0.01;
   std::vector<VecXd> steps;
   for (const bool factorise : {true, false}) {
@@ -184,8 +184,8 @@ TEST_CASE("implicit grid with shells: both preconditioners are symmetric positiv
     obj->apply_preconditioner(r2, z2);
     obj->project(z1);
     obj->project(z2);
-    INFO((factorise ? "factorised" : "block_jacobi") << ": r1.z2 " << r1.dot(z2) << ", r2.z1 "
-                                                      << r2.dot(z1));
+    INFO((factorise ? "factorised" : "block_jacobi")
+         << ": r1.z2 " << r1.dot(z2) << ", r2.z1 " << r2.dot(z1));
     CHECK(std::abs(r1.dot(z2) - r2.dot(z1)) <= 1e-9 * std::sqrt(r1.dot(z1) * r2.dot(z2)));
     CHECK(r1.dot(z1) > 0);
     CHECK(r2.dot(z2) > 0);
@@ -314,9 +314,10 @@ ClothState drop_cloth(Integrator integrator, double dt_max, double t_end) {
 
 }  // namespace
 
-TEST_CASE("implicit grid with shells: a cloth dropped on a ball follows the explicit path at "
-          "small steps and stays stable at one step per frame",
-          "[implicit]") {
+TEST_CASE(
+    "implicit grid with shells: a cloth dropped on a ball follows the explicit path at "
+    "small steps and stays stable at one step per frame",
+    "[implicit]") {
   const double t = 5.0 / 24;
   const ClothState e = drop_cloth(Integrator::Explicit, 1e-2, t);
   const ClothState i = drop_cloth(Integrator::Implicit, 1.0 / 960, t);
@@ -374,9 +375,10 @@ Dent steel_dent(Integrator integrator, double dt_max = 1.0 / 240) {
 // settled dent 9.1 mm explicit, 2.2 mm implicit at 1/240 s, 4.9 mm at 1/2400 s, 3.0 mm at
 // 1e-4 s; docs/implicit.md), so this test checks what holds: both integrators dent the
 // sheet, and both runs stay clean.
-TEST_CASE("implicit grid with shells: the steel sheet struck by a ball at 10 m/s dents with "
-          "both integrators",
-          "[implicit][slow]") {
+TEST_CASE(
+    "implicit grid with shells: the steel sheet struck by a ball at 10 m/s dents with "
+    "both integrators",
+    "[implicit][slow]") {
   const Dent e = steel_dent(Integrator::Explicit);
   const Dent i = steel_dent(Integrator::Implicit);
   INFO("explicit: " << e.steps << " steps, plastic work " << e.plastic_work << " J, depth "
@@ -386,4 +388,26 @@ TEST_CASE("implicit grid with shells: the steel sheet struck by a ball at 10 m/s
   CHECK(e.settled_depth > 5e-3);  // it dents
   CHECK(i.settled_depth > 1e-3);
   CHECK(i.steps < e.steps / 500);
+}
+
+TEST_CASE("implicit grid with shells: the same bits with and without threads", "[implicit]") {
+  Scene s = parse_scene(kSheetOnJelly, "sheet_on_jelly.yaml", {});
+  s.shot.integrator = Integrator::Implicit;
+  s.shot.dt_max = 1.0 / 96;
+  SolverOptions serial;
+  serial.serial = true;
+  Solver a(s, serial), b(s);
+  a.advance_to(2.0 / 48);
+  b.advance_to(2.0 / 48);
+  const ShellObject& sa = *a.shells()[0];
+  const ShellObject& sb = *b.shells()[0];
+  for (std::size_t j = 0; j < sa.size(); ++j) {
+    REQUIRE(sa.x[j] == sb.x[j]);
+    REQUIRE(sa.v[j] == sb.v[j]);
+  }
+  for (std::size_t q = 0; q < a.particles().size(); ++q)
+    REQUIRE(a.particles().x[q] == b.particles().x[q]);
+  const ShellContact& ca = *a.grid_shells()[0].contact;
+  const ShellContact& cb = *b.grid_shells()[0].contact;
+  for (std::size_t p = 0; p < ca.num_sites(); ++p) REQUIRE(ca.a3e[p] == cb.a3e[p]);
 }
