@@ -43,9 +43,10 @@ TEST_CASE("CLI: a contact scene gives the same meshes on 1 and 2 threads and aft
   CHECK(read_text(d.file("a/stats.json")).find("\"contact_compressed\"") != std::string::npos);
 }
 
-TEST_CASE("CLI: an implicit contact scene gives the same meshes on 1 and 2 threads and after "
-          "--resume",
-          "[cli][implicit]") {
+TEST_CASE(
+    "CLI: an implicit contact scene gives the same meshes on 1 and 2 threads and after "
+    "--resume",
+    "[cli][implicit]") {
   TempDir d("contact_implicit");
   // cloth_drape coarsened (16 x 16 elements, dx 0.05), stepped implicitly: the shells'
   // terms are in the grid solve.
