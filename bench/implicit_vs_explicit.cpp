@@ -90,6 +90,20 @@ Case steel_sheet() {
   return c;
 }
 
+/// Sums over timed frames: seconds, steps, Newton and CG iterations, retries.
+struct Totals {
+  double seconds = 0;
+  long steps = 0, newton = 0, cg = 0, retries = 0;
+  void add(const shellmpm_bench::TimedAdvance& r) {
+    seconds += r.seconds;
+    steps += r.stats.substeps;
+    newton += r.stats.implicit_stats.newton_iterations;
+    cg += r.stats.implicit_stats.cg_iterations;
+    retries += r.stats.implicit_stats.retries;
+  }
+  double per_step(long n) const { return steps ? static_cast<double>(n) / steps : 0.0; }
+};
+
 double max_deflection(const ShellObject& sh) {
   double w = 0;
   for (std::size_t i = 0; i < sh.size(); ++i)
@@ -105,16 +119,10 @@ void run(const Case& c, int steps_per_frame, int frames, int threads) {
   }
   ThreadLimit limit(threads);
   Solver solver(s);
-  double seconds = 0;
-  long steps = 0, newton = 0, cg = 0, retries = 0;
+  Totals t;
   std::string deflections;
   for (int f = 0; f < frames; ++f) {
-    const shellmpm_bench::TimedAdvance r = shellmpm_bench::timed_advance(solver, 1.0 / s.shot.fps);
-    seconds += r.seconds;
-    steps += r.stats.substeps;
-    newton += r.stats.implicit_stats.newton_iterations;
-    cg += r.stats.implicit_stats.cg_iterations;
-    retries += r.stats.implicit_stats.retries;
+    t.add(shellmpm_bench::timed_advance(solver, 1.0 / s.shot.fps));
     char buf[32];
     std::snprintf(buf, sizeof buf, "%s%.3f", f ? " " : "",
                   1e3 * max_deflection(*solver.shells()[0]));
@@ -126,9 +134,8 @@ void run(const Case& c, int steps_per_frame, int frames, int threads) {
   std::printf(
       "  %-22s threads %d: %8.3f s/frame, %8.1f steps/frame, Newton %5.1f CG %7.1f per step, "
       "retries %ld; deflection per frame [mm]: %s\n",
-      what.c_str(), threads, seconds / frames, static_cast<double>(steps) / frames,
-      steps ? static_cast<double>(newton) / steps : 0.0,
-      steps ? static_cast<double>(cg) / steps : 0.0, retries, deflections.c_str());
+      what.c_str(), threads, t.seconds / frames, static_cast<double>(t.steps) / frames,
+      t.per_step(t.newton), t.per_step(t.cg), t.retries, deflections.c_str());
 }
 
 /// scenes/steel_dent.yaml over its two moving frames with dt_max (0: explicit).
@@ -140,15 +147,12 @@ void dent(double dt_max, int threads) {
   }
   ThreadLimit limit(threads);
   Solver solver(s);
-  double seconds = 0, plastic = 0;
-  long steps = 0, newton = 0, cg = 0;
+  Totals t;
+  double plastic = 0;
   const int frames = 2;
   for (int f = 0; f < frames; ++f) {
     const shellmpm_bench::TimedAdvance r = shellmpm_bench::timed_advance(solver, 1.0 / s.shot.fps);
-    seconds += r.seconds;
-    steps += r.stats.substeps;
-    newton += r.stats.implicit_stats.newton_iterations;
-    cg += r.stats.implicit_stats.cg_iterations;
+    t.add(r);
     plastic = r.stats.shell_plastic_work;
   }
   ShellObject& sh = *solver.shells()[0];
@@ -159,9 +163,8 @@ void dent(double dt_max, int threads) {
   std::printf(
       "  %-26s threads %d: %8.3f s/frame, %8.1f steps/frame, Newton %5.1f CG %7.1f per step; "
       "plastic work %.3g J, permanent dent %.2f mm\n",
-      what.c_str(), threads, seconds / frames, static_cast<double>(steps) / frames,
-      steps ? static_cast<double>(newton) / steps : 0.0,
-      steps ? static_cast<double>(cg) / steps : 0.0, plastic, 1e3 * (0.1 - low));
+      what.c_str(), threads, t.seconds / frames, static_cast<double>(t.steps) / frames,
+      t.per_step(t.newton), t.per_step(t.cg), plastic, 1e3 * (0.1 - low));
 }
 
 }  // namespace

@@ -33,6 +33,20 @@ void each_shell_point(const SparseGrid& grid, std::size_t b, std::uint32_t count
   }
 }
 
+/// Tangents a_1, a_2 of contact particle p at control points X (differences to its first
+/// control point, as ShellContact::tangents).
+void site_tangents(const ShellContact& c, const std::vector<Vec3d>& X, std::size_t p, Vec3d& a1,
+                   Vec3d& a2) {
+  const Vec3d ref = X[c.idx[c.off[p]]];
+  a1.setZero();
+  a2.setZero();
+  for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
+    const Vec3d d = X[c.idx[k]] - ref;
+    a1 += static_cast<double>(c.N1[k]) * d;
+    a2 += static_cast<double>(c.N2[k]) * d;
+  }
+}
+
 Vec3i corner_of(const SparseGrid& grid, std::size_t b) {
   return unpack_block(grid.pblock_key[b]) * kBlockSize;
 }
@@ -171,13 +185,8 @@ double GridShellTerms::evaluate(bool grad) {
     std::vector<Mat3d> G(grad ? ns : 0);
     const ContactParams& cp = c.params();
     e += ordered_reduce(ns, kSiteGrain, serial_, 0.0, [&](std::size_t p) {
-      const Vec3d ref = S.X[c.idx[c.off[p]]];
-      Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
-      for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
-        const Vec3d d = S.X[c.idx[k]] - ref;
-        a1 += static_cast<double>(c.N1[k]) * d;
-        a2 += static_cast<double>(c.N2[k]) * d;
-      }
+      Vec3d a1, a2;
+      site_tangents(c, S.X, p, a1, a2);
       const double V = static_cast<double>(c.volume[p]);
       Mat3d Gp;
       const double psi = contact_gradient<double>(a1, a2, a3_[s0 + p], cp, grad ? &Gp : nullptr);
@@ -258,13 +267,8 @@ void GridShellTerms::contact_forces(std::size_t s, const std::vector<Vec3d>& X,
   const ShellContact& c = *sh_[s].gs->contact;
   const std::uint32_t s0 = site_start_[s];
   for (std::size_t p = 0; p < c.num_sites(); ++p) {
-    const Vec3d ref = X[c.idx[c.off[p]]];
-    Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
-    for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
-      const Vec3d d = X[c.idx[k]] - ref;
-      a1 += static_cast<double>(c.N1[k]) * d;
-      a2 += static_cast<double>(c.N2[k]) * d;
-    }
+    Vec3d a1, a2;
+    site_tangents(c, X, p, a1, a2);
     Mat3d G;
     contact_gradient<double>(a1, a2, a3_[s0 + p], c.params(), &G);
     G *= static_cast<double>(c.volume[p]);
@@ -339,12 +343,8 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
     // gradient, made positive semi-definite: its a3E-a3E block and its coupling to the
     // control points (the a1, a2 blocks enter through the forces' differences below).
     for (std::size_t p = 0; p < c.num_sites(); ++p) {
-      const Vec3d ref = S.X[c.idx[c.off[p]]];
-      Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
-      for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
-        a1 += static_cast<double>(c.N1[k]) * (S.X[c.idx[k]] - ref);
-        a2 += static_cast<double>(c.N2[k]) * (S.X[c.idx[k]] - ref);
-      }
+      Vec3d a1, a2;
+      site_tangents(c, S.X, p, a1, a2);
       Eigen::Matrix<double, 9, 1> y;
       y << a1, a2, a3_[site_start_[s] + p];
       const auto grad = [&](const Eigen::Matrix<double, 9, 1>& q) {
