@@ -68,9 +68,6 @@ class GridShellTerms {
   /// Adds diag(J^T K J) at vel to diag (the block_jacobi preconditioner).
   void add_diagonal(const std::vector<PadD>& vel, VecXd& diag);
 
-  /// Where the control points end (for tests): X(u) of grid shell s.
-  const std::vector<Vec3d>& moved(std::size_t s) const { return sh_[s].X; }
-
  private:
   struct Shell {
     const GridShell* gs = nullptr;
