@@ -47,6 +47,27 @@ void site_tangents(const ShellContact& c, const std::vector<Vec3d>& X, std::size
   }
 }
 
+/// V psi of contact particle p at control points X with normal column a3; with G, also
+/// V dpsi/d(a1, a2, a3E) (columns).
+double site_energy(const ShellContact& c, const std::vector<Vec3d>& X, std::size_t p,
+                   const Vec3d& a3, Mat3d* G) {
+  Vec3d a1, a2;
+  site_tangents(c, X, p, a1, a2);
+  const double V = static_cast<double>(c.volume[p]);
+  const double psi = contact_gradient<double>(a1, a2, a3, c.params(), G);
+  if (G) *G *= V;
+  return V * psi;
+}
+
+/// Adds sign times contact particle p's dpsi/da_beta (columns 0, 1 of G) to its control
+/// points' entries of out (dN_k/dxi_beta times them).
+void scatter_tangential(const ShellContact& c, std::size_t p, const Mat3d& G, double sign,
+                        std::vector<Vec3d>& out) {
+  for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k)
+    out[c.idx[k]] +=
+        sign * (static_cast<double>(c.N1[k]) * G.col(0) + static_cast<double>(c.N2[k]) * G.col(1));
+}
+
 Vec3i corner_of(const SparseGrid& grid, std::size_t b) {
   return unpack_block(grid.pblock_key[b]) * kBlockSize;
 }
@@ -159,11 +180,9 @@ void GridShellTerms::advance_sites(const std::vector<PadD>& vel) {
           const Site& st = sites_[i];
           if (!st.any) return;
           Vec3d d = Vec3d::Zero();
-          int n = 0;
-          for (int x = 0; x < 3; ++x)
-            for (int y = 0; y < 3; ++y)
-              for (int z = 0; z < 3; ++z, ++n)
-                d += st.ga[n] * vel[b][pad_node(st.lx + x, st.ly + y, st.lz + z)];
+          each_site_node(st, [&](int n, int px, int py, int pz) {
+            d += st.ga[n] * vel[b][pad_node(px, py, pz)];
+          });
           a3_[i] += d;
         });
       },
@@ -183,18 +202,10 @@ double GridShellTerms::evaluate(bool grad) {
     const std::uint32_t s0 = site_start_[s];
     const std::size_t ns = c.num_sites();
     std::vector<Mat3d> G(grad ? ns : 0);
-    const ContactParams& cp = c.params();
     e += ordered_reduce(ns, kSiteGrain, serial_, 0.0, [&](std::size_t p) {
-      Vec3d a1, a2;
-      site_tangents(c, S.X, p, a1, a2);
-      const double V = static_cast<double>(c.volume[p]);
-      Mat3d Gp;
-      const double psi = contact_gradient<double>(a1, a2, a3_[s0 + p], cp, grad ? &Gp : nullptr);
-      if (grad) {
-        G[p] = V * Gp;
-        G3_[s0 + p] = G[p].col(2);
-      }
-      return V * psi;
+      const double ep = site_energy(c, S.X, p, a3_[s0 + p], grad ? &G[p] : nullptr);
+      if (grad) G3_[s0 + p] = G[p].col(2);
+      return ep;
     });
     // Damping and loads on the free components.
     for (std::size_t j = 0; j < n; ++j) {
@@ -207,10 +218,7 @@ double GridShellTerms::evaluate(bool grad) {
     }
     if (!grad) continue;
     S.dX.assign(n, Vec3d::Zero());
-    for (std::size_t p = 0; p < ns; ++p)
-      for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k)
-        S.dX[c.idx[k]] +=
-            static_cast<double>(c.N1[k]) * G[p].col(0) + static_cast<double>(c.N2[k]) * G[p].col(1);
+    for (std::size_t p = 0; p < ns; ++p) scatter_tangential(c, p, G[p], 1.0, S.dX);
     for (std::size_t j = 0; j < n; ++j) {
       const double m = static_cast<double>(sh.mass[j]);
       for (int a = 0; a < 3; ++a)
@@ -251,11 +259,9 @@ double GridShellTerms::gradient(const std::vector<PadD>& vel, std::vector<PadD>&
           const std::size_t i = site_start_[table_.shell(g)] + table_.local(g);
           const Site& st = sites_[i];
           if (!st.any) return;
-          int n = 0;
-          for (int x = 0; x < 3; ++x)
-            for (int y = 0; y < 3; ++y)
-              for (int z = 0; z < 3; ++z, ++n)
-                grad[b][pad_node(st.lx + x, st.ly + y, st.lz + z)] += st.ga[n] * G3_[i];
+          each_site_node(st, [&](int n, int px, int py, int pz) {
+            grad[b][pad_node(px, py, pz)] += st.ga[n] * G3_[i];
+          });
         });
       },
       serial_);
@@ -265,16 +271,10 @@ double GridShellTerms::gradient(const std::vector<PadD>& vel, std::vector<PadD>&
 void GridShellTerms::contact_forces(std::size_t s, const std::vector<Vec3d>& X,
                                     std::vector<Vec3d>& f) const {
   const ShellContact& c = *sh_[s].gs->contact;
-  const std::uint32_t s0 = site_start_[s];
   for (std::size_t p = 0; p < c.num_sites(); ++p) {
-    Vec3d a1, a2;
-    site_tangents(c, X, p, a1, a2);
     Mat3d G;
-    contact_gradient<double>(a1, a2, a3_[s0 + p], c.params(), &G);
-    G *= static_cast<double>(c.volume[p]);
-    for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k)
-      f[c.idx[k]] -=
-          static_cast<double>(c.N1[k]) * G.col(0) + static_cast<double>(c.N2[k]) * G.col(1);
+    site_energy(c, X, p, a3_[site_start_[s] + p], &G);
+    scatter_tangential(c, p, G, -1.0, f);
   }
 }
 
@@ -319,15 +319,11 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
       const Site& st = sites_[site_start_[s] + j];
       if (!st.any) return;
       const int row = first[s] + nfree[s] + 3 * static_cast<int>(j);
-      int n = 0;
-      for (int x = 0; x < 3; ++x)
-        for (int y = 0; y < 3; ++y)
-          for (int z = 0; z < 3; ++z, ++n) {
-            if (st.ga[n] == 0) continue;
-            const auto node =
-                static_cast<Eigen::Index>(node_of(grid_, b, st.lx + x, st.ly + y, st.lz + z));
-            for (int a = 0; a < 3; ++a) tj.emplace_back(row + a, 3 * node + a, st.ga[n]);
-          }
+      each_site_node(st, [&](int n, int px, int py, int pz) {
+        if (st.ga[n] == 0) return;
+        const auto node = static_cast<Eigen::Index>(node_of(grid_, b, px, py, pz));
+        for (int a = 0; a < 3; ++a) tj.emplace_back(row + a, 3 * node + a, st.ga[n]);
+      });
     });
   }
   J.resize(first.back(), N);

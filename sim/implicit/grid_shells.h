@@ -85,6 +85,15 @@ class GridShellTerms {
     bool any;
     double ga[27];
   };
+  /// Calls f(n, px, py, pz) for the 27 stencil nodes of st (n as in ga; padded-buffer
+  /// coordinates in its particle block).
+  template <class F>
+  static void each_site_node(const Site& st, F&& f) {
+    int n = 0;
+    for (int x = 0; x < 3; ++x)
+      for (int y = 0; y < 3; ++y)
+        for (int z = 0; z < 3; ++z, ++n) f(n, st.lx + x, st.ly + y, st.lz + z);
+  }
   /// X of every control point from vel; v_j kept in V_.
   void move(const std::vector<PadD>& vel);
   /// a3E(u) of every contact particle from vel.
