@@ -34,6 +34,14 @@ void ShellPointTable::positions(const std::vector<GridShell>& shells,
   for (const GridShell& g : shells) out.insert(out.end(), g.contact->x.begin(), g.contact->x.end());
 }
 
+void ShellPointTable::velocities(const std::vector<GridShell>& shells,
+                                 std::vector<Vec3>& out) const {
+  out.clear();
+  out.reserve(size());
+  for (const GridShell& g : shells) out.insert(out.end(), g.shell->v.begin(), g.shell->v.end());
+  out.resize(size(), Vec3::Zero());
+}
+
 void prescribe_pins(ShellObject& sh, double t, double dt, std::vector<std::uint8_t>& held) {
   const ShellDesc& d = sh.desc();
   held.assign(sh.size(), 0);

@@ -44,6 +44,9 @@ class ShellPointTable {
   std::uint32_t num_control_points() const { return num_ctrl_; }
   /// Current positions in binning order (control points, then contact particles).
   void positions(const std::vector<GridShell>& shells, std::vector<Vec3>& out) const;
+  /// Velocities in binning order: the control points', zero for contact particles (they
+  /// move with them).
+  void velocities(const std::vector<GridShell>& shells, std::vector<Vec3>& out) const;
   std::uint16_t shell(std::uint32_t i) const { return shell_[i]; }
   std::uint32_t local(std::uint32_t i) const { return local_[i]; }
 

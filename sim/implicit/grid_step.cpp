@@ -158,6 +158,8 @@ class GridObjective final : public ImplicitObjective {
       for (std::size_t k = 0; k < in_.colliders->size(); ++k) {
         const Collider& col = (*in_.colliders)[k];
         if (col.phi(x) > 0) continue;
+        if (in_.reach && !in_.reach->engaged(i / kBlockNodes, static_cast<int>(i % kBlockNodes), k))
+          continue;
         const Vec3d n = col.normal(x), vc = col.velocity(x);
         const BoundaryKind kind = col.desc().boundary;
         if (kind == BoundaryKind::Sticky) {

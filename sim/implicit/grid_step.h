@@ -11,7 +11,8 @@
 //
 // Constraints, projected inside CG (newton.h): nodes without mass; the domain walls
 // (a component whose predicted velocity v^n + dt g points into a wall within kWallCells is
-// held at 0); colliders, from the predicted velocity: sticky nodes take the collider's
+// held at 0); colliders, at the nodes within reach of material (collider_reach.h), from
+// the predicted velocity: sticky nodes take the collider's
 // velocity, slip and separate (approaching) nodes keep the collider's normal velocity and
 // move freely along the surface. Coulomb friction follows the solve at those nodes, with
 // the normal impulse the constraint applied (the explicit collider stage takes it from the
@@ -30,6 +31,7 @@
 #include <vector>
 
 #include "sim/collider/collider.h"
+#include "sim/collider/collider_reach.h"
 #include "sim/implicit/grid_shells.h"
 #include "sim/implicit/newton.h"
 #include "sim/mpm/constitutive.h"
@@ -44,6 +46,9 @@ struct GridStepInput {
   const std::vector<ConstitutiveModelT<double>>* models = nullptr;
   const std::vector<Real>* densities = nullptr;
   const std::vector<Collider>* colliders = nullptr;  ///< posed for the step (begin_step)
+  /// The nodes within reach of each collider (collider_reach.h), for the same pose; null:
+  /// every node inside a collider takes its condition.
+  const ColliderReach* reach = nullptr;
   Vec3d gravity{0, 0, 0};
   Vec3i domain_cells{0, 0, 0};
   int wall_cells = 3;

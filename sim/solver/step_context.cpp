@@ -48,6 +48,14 @@ void StepContext::apply_walls() {
       opt.serial);
 }
 
+void StepContext::compute_collider_reach() {
+  const bool shells = !grid_shells.empty();
+  if (shells) shell_table.velocities(grid_shells, reach_velocities);
+  collider_reach.compute(grid, shells ? &shell_points : nullptr,
+                         shells ? &reach_velocities : nullptr, particles.x, particles.v, colliders,
+                         kColliderReachCells * grid.dx(), dt, opt.serial);
+}
+
 bool StepContext::single_velocity_node(const Vec3i& n) const {
   for (int a = 0; a < 3; ++a)
     if (n[a] < kWallCells || n[a] > domain_cells[a] - kWallCells) return true;

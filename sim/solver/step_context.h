@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sim/collider/collider.h"
+#include "sim/collider/collider_reach.h"
 #include "sim/contact/shell_contact.h"
 #include "sim/contact/shell_fields.h"
 #include "sim/contact/shell_guard.h"
@@ -69,6 +70,10 @@ struct StepContext {
   ShellFields shell_fields;        ///< per-shell velocities on shared nodes: p2g, g2p
   ShellPointTable shell_table;     ///< grid shells' points in the combined binning
   std::vector<Vec3> shell_points;  ///< written by bin, read by p2g and g2p
+  /// Which nodes take each collider's condition (collider_reach.h): written by colliders
+  /// and implicit_grid, for the colliders' pose at the end of the step.
+  ColliderReach collider_reach;
+  std::vector<Vec3> reach_velocities;  ///< scratch of compute_collider_reach
   /// The grid shells' control points at the start of the step (x^n): written by g2p
   /// before it moves them, read by shell_guard, which runs after the colliders have
   /// projected points out (so x - dt v is not x^n for every point any more).
@@ -89,6 +94,8 @@ struct StepContext {
   TransferParams transfer_params() const;
   /// Keeps particles, control points and contact particles one cell inside the domain.
   void clamp_to_domain();
+  /// Marks the nodes within reach of the colliders (posed for the step) in collider_reach.
+  void compute_collider_reach();
   /// Stops the velocity components that point into the domain walls.
   void apply_walls();
   /// Nodes where shells keep one shared velocity: walls and colliders.

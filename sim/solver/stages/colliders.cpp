@@ -11,6 +11,7 @@ bool CollidersStage::needed(const Scene& s) {
 
 void CollidersStage::run(StepContext& c) {
   for (Collider& col : c.colliders) col.begin_step(c.time, c.dt);
+  c.compute_collider_reach();
   const double dx = c.grid.dx();
   parallel_for_each(
       c.grid.num_grid_blocks(), 16,
@@ -19,9 +20,12 @@ void CollidersStage::run(StepContext& c) {
         Aabb box;
         box.lo = c.grid.node_position(corner).array() - dx;
         box.hi = c.grid.node_position(corner + Vec3i::Constant(kBlockSize - 1)).array() + dx;
-        for (const Collider& col : c.colliders) {
+        for (std::size_t k = 0; k < c.colliders.size(); ++k) {
+          const Collider& col = c.colliders[k];
           if (!col.bounds().overlaps(box)) continue;
           c.grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
+            const Vec3i l = n - corner;
+            if (!c.collider_reach.engaged(b, block_node(l[0], l[1], l[2]), k)) return;
             Vec3 v(nd.v[0], nd.v[1], nd.v[2]);
             if (col.apply(c.grid.node_position(n), v)) {
               nd.v[0] = v[0];

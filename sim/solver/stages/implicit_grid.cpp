@@ -40,6 +40,10 @@ void ImplicitGridStage::run(StepContext& c) {
   double dt = c.dt;
   while (true) {
     for (Collider& col : c.colliders) col.begin_step(c.time, dt);
+    if (!c.colliders.empty()) {
+      c.compute_collider_reach();
+      in.reach = &c.collider_reach;
+    }
     std::unique_ptr<GridShellTerms> shells;
     if (!c.grid_shells.empty()) {
       shells = std::make_unique<GridShellTerms>(c.grid, c.shell_table, c.grid_shells, kls_, c.time,

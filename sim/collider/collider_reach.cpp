@@ -1,0 +1,70 @@
+#include "sim/collider/collider_reach.h"
+
+#include <algorithm>
+
+#include "sim/core/parallel.h"
+#include "sim/mpm/bspline.h"
+
+namespace shellmpm {
+
+void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* first,
+                            const std::vector<Vec3>* first_v, const std::vector<Vec3>& x,
+                            const std::vector<Vec3>& v, const std::vector<Collider>& colliders,
+                            double reach, double dt, bool serial) {
+  const std::size_t nb = grid.num_particle_blocks();
+  const std::size_t nf = first ? first->size() : 0;
+  const std::size_t nk = std::min<std::size_t>(colliders.size(), 32);
+  const double dx = grid.dx();
+  buf_.resize(nb);
+  parallel_for_each(
+      nb, 4,
+      [&](std::size_t b) {
+        std::array<std::uint32_t, kPadNodes>& buf = buf_[b];
+        buf.fill(0);
+        const Vec3i corner = unpack_block(grid.pblock_key[b]) * kBlockSize;
+        // The block's points and the nodes they reach lie within 2.5 dx of its cells; a
+        // point that moves further in a step is caught by the particle projection.
+        Aabb box;
+        box.lo = grid.node_position(corner).array() - 2.5 * dx - reach;
+        box.hi =
+            grid.node_position(corner + Vec3i::Constant(kBlockSize)).array() + 2.5 * dx + reach;
+        std::uint32_t near = 0;
+        for (std::size_t k = 0; k < nk; ++k)
+          if (colliders[k].bounds().overlaps(box)) near |= 1u << k;
+        if (!near) return;
+        for (std::uint32_t s = grid.pblock_start[b]; s < grid.pblock_start[b + 1]; ++s) {
+          const std::uint32_t i = grid.order[s];
+          const Vec3& p = i < nf ? (*first)[i] : x[i - nf];
+          const Vec3d pd = p.cast<double>();
+          const Vec3d pe = pd + dt * (i < nf ? (*first_v)[i] : v[i - nf]).cast<double>();
+          std::uint32_t bits = 0;
+          for (std::size_t k = 0; k < nk; ++k)
+            if (((near >> k) & 1u) && std::min(colliders[k].phi(pd), colliders[k].phi(pe)) <= reach)
+              bits |= 1u << k;
+          if (!bits) continue;
+          const QuadraticWeights W(grid.grid_coord(p));
+          const int lx = W.base[0] - corner[0], ly = W.base[1] - corner[1],
+                    lz = W.base[2] - corner[2];
+          for (int a = 0; a < 3; ++a)
+            for (int c = 0; c < 3; ++c)
+              for (int d = 0; d < 3; ++d) buf[pad_node(lx + a, ly + c, lz + d)] |= bits;
+        }
+      },
+      serial);
+  mask_.assign(grid.num_grid_blocks() * kBlockNodes, 0);
+  parallel_for_each(
+      grid.num_grid_blocks(), 16,
+      [&](std::size_t g) {
+        grid.for_each_buffer_node(g, [&](int bn, std::size_t src, int pn) {
+          mask_[g * kBlockNodes + static_cast<std::size_t>(bn)] |= buf_[src][pn];
+        });
+      },
+      serial);
+}
+
+std::size_t ColliderReach::count() const {
+  return static_cast<std::size_t>(
+      std::count_if(mask_.begin(), mask_.end(), [](std::uint32_t m) { return m != 0; }));
+}
+
+}  // namespace shellmpm
