@@ -94,6 +94,7 @@ GridShellTerms::GridShellTerms(const SparseGrid& grid, const ShellPointTable& ta
     sh.external_forces(Vec3d::Zero(), S.x0, S.fext);
     sh.pin_targets(t, dt, S.held, S.target);
     S.damping = sh.material().damping;
+    S.membrane = sh.material().youngs_modulus * sh.material().thickness;
     Eigen::AlignedBox<double, 3> box;
     for (const Vec3d& p : S.x0) box.extend(p);
     S.length = std::max(box.diagonal().norm(), 1e-12);
@@ -216,8 +217,9 @@ double GridShellTerms::evaluate(bool grad) {
         e += dt_ * (0.5 * S.damping * m * v * v - S.fext[j][a] * v);
       }
     }
+    if (grad) S.dX.assign(n, Vec3d::Zero());
+    e += collider_penalty(S, grad, nullptr);
     if (!grad) continue;
-    S.dX.assign(n, Vec3d::Zero());
     for (std::size_t p = 0; p < ns; ++p) scatter_tangential(c, p, G[p], 1.0, S.dX);
     for (std::size_t j = 0; j < n; ++j) {
       const double m = static_cast<double>(sh.mass[j]);
@@ -225,6 +227,27 @@ double GridShellTerms::evaluate(bool grad) {
         S.dX[j][a] = (S.held[j] & (1u << a))
                          ? 0.0
                          : S.dX[j][a] - S.f[j][a] + S.damping * m * S.v[j][a] - S.fext[j][a];
+    }
+  }
+  return e;
+}
+
+double GridShellTerms::collider_penalty(Shell& S, bool grad, std::vector<Mat3d>* K) const {
+  if (K) K->assign(S.X.size(), Mat3d::Zero());
+  if (!colliders_ || colliders_->empty()) return 0;
+  const ShellObject& sh = *S.gs->shell;
+  double e = 0;
+  for (std::size_t j = 0; j < S.X.size(); ++j) {
+    if (S.held[j] == 7u) continue;
+    const double kappa =
+        kColliderPenalty * std::max(static_cast<double>(sh.mass[j]) / (dt_ * dt_), S.membrane);
+    for (const Collider& col : *colliders_) {
+      const double phi = col.phi(S.X[j]);
+      if (!(phi < 0)) continue;
+      e += 0.5 * kappa * phi * phi;
+      const Vec3d n = col.normal(S.X[j]);
+      if (grad) S.dX[j] += kappa * phi * n;
+      if (K) (*K)[j] += kappa * n * n.transpose();
     }
   }
   return e;
@@ -380,6 +403,15 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
       }
     }
     if (nfree[s] == 0) continue;
+    std::vector<Mat3d> Kc;
+    collider_penalty(sh_[s], false, &Kc);
+    for (std::size_t j = 0; j < n; ++j)
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          const int da = dof_of[s][3 * j + a], db = dof_of[s][3 * j + b];
+          if (da >= 0 && db >= 0 && Kc[j](a, b) != 0)
+            tk.emplace_back(first[s] + da, first[s] + db, Kc[j](a, b));
+        }
     std::vector<char> movable(n, 0);
     for (std::size_t k = 0; k < 3 * n; ++k)
       if (dof_of[s][k] >= 0) movable[k / 3] = 1;

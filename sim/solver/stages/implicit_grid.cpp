@@ -48,6 +48,7 @@ void ImplicitGridStage::run(StepContext& c) {
     if (!c.grid_shells.empty()) {
       shells = std::make_unique<GridShellTerms>(c.grid, c.shell_table, c.grid_shells, kls_, c.time,
                                                 dt, c.opt.serial);
+      shells->set_colliders(&c.colliders);
       in.shells = shells.get();
     }
     const NewtonReport rep = implicit_grid_step(in, dt, opt);

@@ -160,6 +160,66 @@ TEST_CASE("implicit grid with shells: the gradient matches finite differences", 
 }
 
 TEST_CASE(
+    "implicit grid with shells: the collider penalty on control points matches finite "
+    "differences and pushes them out",
+    "[implicit]") {
+  Rig rig;
+  const double dt = 0.01;
+  // A ball pressing into the sheet from above: some control points start inside it.
+  ColliderDesc cd;
+  cd.name = "ball";
+  cd.shape.kind = ShapeDesc::Kind::Sphere;
+  cd.shape.center = Vec3d(0.03, 0.49, 0.0);
+  cd.shape.radius = 0.08;
+  std::vector<Collider> cols{Collider(cd)};
+  cols[0].begin_step(0, dt);
+  std::size_t inside = 0;
+  for (const Vec3& x : rig.shell->x) inside += cols[0].phi(x.cast<double>()) < 0;
+  REQUIRE(inside > 0);
+  GridShellTerms with(rig.grid, rig.table, rig.shells, rig.kls, 0.0, dt, true);
+  with.set_colliders(&cols);
+  GridShellTerms without(rig.grid, rig.table, rig.shells, rig.kls, 0.0, dt, true);
+  const GridStepInput in = rig.input(&with);
+  GridStepInput in0 = rig.input(&without);
+  VecXd u0, g, u00, g0;
+  const auto obj = grid_objective(in, dt, u0);
+  const auto obj0 = grid_objective(in0, dt, u00);
+  VecXd d(u0.size());
+  for (Eigen::Index k = 0; k < d.size(); ++k) d[k] = std::sin(1.3 * k + 0.7);
+  obj->project(d);
+  obj->gradient(u0, g);
+  obj0->gradient(u0, g0);
+  const double slope = g.dot(d), share = std::abs(slope - g0.dot(d));
+  INFO("slope " << slope << ", the penalty's share " << share << " (" << inside
+                << " control points inside)");
+  CHECK(obj->energy(u0) > obj0->energy(u0));
+  CHECK(share > 1e-3 * std::abs(slope));
+  for (const double eps : {1e-4, 1e-5}) {
+    const double fd = (obj->energy(u0 + eps * d) - obj->energy(u0 - eps * d)) / (2 * eps);
+    CHECK(std::abs(fd - slope) < 1e-3 * share);
+  }
+  // Newton with the penalty ends with less of it than it started with, and with both
+  // preconditioners the same step.
+  std::vector<VecXd> steps;
+  for (const bool factorise : {true, false}) {
+    GridStepInput inf = in;
+    inf.factorise = factorise;
+    VecXd u;
+    const auto o = grid_objective(inf, dt, u);
+    const double e0 = o->energy(u) - obj0->energy(u);
+    NewtonOptions opt;
+    opt.tolerance = 1e-7;
+    const NewtonReport rep = newton_minimise(*o, u, opt);
+    CHECK(rep.converged);
+    const double e1 = o->energy(u) - obj0->energy(u);
+    INFO("penalty energy before " << e0 << ", after " << e1);
+    CHECK(e1 < 0.5 * e0);
+    steps.push_back(u);
+  }
+  CHECK((steps[0] - steps[1]).lpNorm<Eigen::Infinity>() < 1e-6);
+}
+
+TEST_CASE(
     "implicit grid with shells: both preconditioners are symmetric positive definite and "
     "give the same step",
     "[implicit]") {
@@ -371,23 +431,30 @@ Dent steel_dent(Integrator integrator, double dt_max = 1.0 / 240) {
 
 }  // namespace
 
-// Issue 14 asks for the implicit dent within 5% of the explicit one. Not met yet (2026-12-03:
-// settled dent 9.1 mm explicit, 2.2 mm implicit at 1/240 s, 4.9 mm at 1/2400 s, 3.0 mm at
-// 1e-4 s; docs/implicit.md), so this test checks what holds: both integrators dent the
-// sheet, and both runs stay clean.
+// Issue 14 asks for the implicit dent within 5% of the explicit one. Not met yet
+// (2026-12-03, docs/implicit.md): the settled dent is 19.5 mm explicit (19.6 at half the
+// step: converged), 15.4 mm implicit at 1/240 s and 16.8 mm at 1/2400 s. Backward Euler
+// damps the struck sheet's rebound ahead of the ball, which deepens the explicit dent.
+// What holds is checked: both dent, the implicit dents stay within 25% of the explicit
+// one and within 15% of each other across a tenfold change of step (without the
+// collider penalty on the control points they were 22.0 and 16.7 mm), with over 500
+// times fewer steps, and every run stays clean.
 TEST_CASE(
-    "implicit grid with shells: the steel sheet struck by a ball at 10 m/s dents with "
+    "implicit grid with shells: the steel sheet struck by a ball at 10 m/s dents alike with "
     "both integrators",
     "[implicit][slow]") {
   const Dent e = steel_dent(Integrator::Explicit);
-  const Dent i = steel_dent(Integrator::Implicit);
-  INFO("explicit: " << e.steps << " steps, plastic work " << e.plastic_work << " J, depth "
-                    << e.depth << " m, settled " << e.settled_depth << " m; implicit: " << i.steps
-                    << " steps, " << i.plastic_work << " J, depth " << i.depth << " m, settled "
-                    << i.settled_depth << " m");
-  CHECK(e.settled_depth > 5e-3);  // it dents
-  CHECK(i.settled_depth > 1e-3);
-  CHECK(i.steps < e.steps / 500);
+  const Dent a = steel_dent(Integrator::Implicit, 1.0 / 240);
+  const Dent b = steel_dent(Integrator::Implicit, 1.0 / 2400);
+  INFO("explicit: " << e.steps << " steps, plastic work " << e.plastic_work << " J, settled "
+                    << e.settled_depth << " m; implicit 1/240 s: " << a.steps << " steps, "
+                    << a.plastic_work << " J, settled " << a.settled_depth << " m; 1/2400 s: "
+                    << b.steps << " steps, settled " << b.settled_depth << " m");
+  CHECK(e.settled_depth > 0.01);  // it dents, a good part of the 3 cm press
+  CHECK(std::abs(a.settled_depth - e.settled_depth) < 0.25 * e.settled_depth);
+  CHECK(std::abs(b.settled_depth - e.settled_depth) < 0.25 * e.settled_depth);
+  CHECK(std::abs(a.settled_depth - b.settled_depth) < 0.15 * e.settled_depth);
+  CHECK(a.steps < e.steps / 500);
 }
 
 TEST_CASE("implicit grid with shells: the same bits with and without threads", "[implicit]") {
