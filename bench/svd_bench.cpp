@@ -2,7 +2,9 @@
 // per-particle constitutive calls (sim/mpm/constitutive.h), single thread. Inputs are
 // typical MPM deformation gradients, F = R (I + 0.2 N) with N uniform in [-1, 1].
 // Each figure is the best of several repetitions over the same array of matrices,
-// so it is throughput on independent particles (what the solver's loops see).
+// so it is throughput on independent particles (what the solver's loops see). The batch
+// calls in the simulation precision are timed at each instruction-set level the machine
+// has (sim/mpm/stress_batch.h).
 //
 //   svd_bench [--n N] [--reps R]
 #include <Eigen/Geometry>
@@ -13,10 +15,12 @@
 #include <cstring>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "sim/math/svd3.h"
 #include "sim/mpm/constitutive.h"
+#include "sim/mpm/stress_batch.h"
 
 using namespace shellmpm;
 
@@ -51,6 +55,10 @@ double ns_per_item(std::size_t n, int reps, Body&& body) {
 }
 
 volatile double g_sink = 0;  // keeps results observable
+
+constexpr bool kOtherIsFloat = !std::is_same_v<Real, float>;
+constexpr const char* kRealName = std::is_same_v<Real, float> ? "float" : "double";
+constexpr const char* kOtherName = kOtherIsFloat ? "float (library code)" : "double (library code)";
 
 template <class T>
 void bench_svd(const char* name, std::size_t n, int reps) {
@@ -158,7 +166,13 @@ int main(int argc, char** argv) {
               reps);
   bench_svd<float>("float", n, reps);
   bench_svd<double>("double", n, reps);
-  bench_models<float>("float", n, reps);
-  bench_models<double>("double", n, reps);
+  // The batch calls in the simulation precision run on the machine's widest vector unit
+  // (sim/mpm/stress_batch.h): each level it has, widest first.
+  for (int level = static_cast<int>(simd_supported()); level >= 0; --level) {
+    set_simd_level(static_cast<SimdLevel>(level));
+    const std::string label = std::string(kRealName) + ", " + simd_name(simd_level());
+    bench_models<Real>(label.c_str(), n, reps);
+  }
+  bench_models<std::conditional_t<kOtherIsFloat, float, double>>(kOtherName, n, reps);
   return 0;
 }

@@ -22,6 +22,7 @@
 #include "sim/mpm/materials/fixed_corotated.h"
 #include "sim/mpm/materials/neo_hookean.h"
 #include "sim/mpm/materials/snow.h"
+#include "sim/mpm/stress_batch.h"
 #include "sim/scene/scene.h"
 
 namespace shellmpm {
@@ -163,6 +164,10 @@ struct ConstitutiveModelT {
       if (m.project_sigma(sigma, plastic)) F = U * sigma.asDiagonal() * V.transpose();
     }
   }
+
+ public:
+  /// The batch loop for model m (what the batch calls run; stress_batch.h compiles it per
+  /// instruction set).
   template <bool kProject, bool kStress, class M>
   static void batch_impl(const M& m, Mat3T* F_inout, const Mat3T* F_in, T* plastic_inout,
                          const T* plastic_in, Mat3T* tau, std::size_t n);
@@ -258,6 +263,8 @@ inline void ConstitutiveModelT<T>::kirchhoff_batch(const Mat3T* F, const T* plas
           for (std::size_t i = 0; i < n; ++i)
             tau[i] = m.kirchhoff(F[i], plastic ? plastic[i] : m.initial_plastic());
         } else {
+          if constexpr (std::is_same_v<T, Real>)
+            if (stress_batch::kirchhoff(*this, F, plastic, tau, n)) return;
           batch_impl<false, true>(m, nullptr, F, nullptr, plastic, tau, n);
         }
       },
@@ -272,6 +279,8 @@ inline void ConstitutiveModelT<T>::project_batch(Mat3T* F, T* plastic, std::size
         if constexpr (M::kPlastic) {
           constexpr bool kSnow = std::is_same_v<M, SnowT<T>>;
           SHELLMPM_CHECK(plastic != nullptr || !kSnow, "snow needs J_P");
+          if constexpr (std::is_same_v<T, Real>)
+            if (stress_batch::project(*this, F, plastic, n)) return;
           batch_impl<true, false>(m, F, nullptr, plastic, nullptr, nullptr, n);
         }
       },
@@ -289,6 +298,8 @@ inline void ConstitutiveModelT<T>::project_and_kirchhoff_batch(Mat3T* F, T* plas
         } else {
           constexpr bool kSnow = std::is_same_v<M, SnowT<T>>;
           SHELLMPM_CHECK(plastic != nullptr || !kSnow, "snow needs J_P");
+          if constexpr (std::is_same_v<T, Real>)
+            if (stress_batch::project_and_kirchhoff(*this, F, plastic, tau, n)) return;
           batch_impl<true, true>(m, F, nullptr, plastic, nullptr, tau, n);
         }
       },

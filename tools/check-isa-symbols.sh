@@ -1,0 +1,32 @@
+#!/bin/sh
+# The per-ISA objects of sim/mpm/stress_batch.h must define nothing but their entry
+# points: an inline function emitted there (a weak symbol) could be the copy the linker
+# keeps for every other translation unit, which would then need AVX2 or AVX-512.
+# Usage: check-isa-symbols.sh OBJECT... (the others are ignored)
+status=0
+found=0
+for obj in "$@"; do
+  case "$obj" in
+    *stress_batch_avx*) ;;
+    *) continue ;;
+  esac
+  found=$((found + 1))
+  if ! syms=$(nm -C --defined-only "$obj"); then
+    echo "nm could not read $obj"
+    status=1
+    continue
+  fi
+  extra=$(echo "$syms" | grep -v ' [tTrRbBdD] ' | grep -v '^$' | grep -v ':$')
+  strong=$(echo "$syms" | grep ' T ' | grep -v 'shellmpm::stress_batch::run_avx')
+  if [ -n "$extra$strong" ]; then
+    echo "$obj defines more than its entry point:"
+    echo "$extra"
+    echo "$strong"
+    status=1
+  fi
+done
+if [ "$found" -ne 2 ]; then
+  echo "expected the two stress_batch_avx objects, found $found"
+  status=1
+fi
+exit $status
