@@ -41,6 +41,7 @@ void ImplicitGridStage::run(StepContext& c) {
   while (true) {
     for (Collider& col : c.colliders) col.begin_step(c.time, dt);
     if (!c.colliders.empty()) {
+      c.dt = dt;  // the reach's prediction covers the step tried
       c.compute_collider_reach();
       in.reach = &c.collider_reach;
     }
