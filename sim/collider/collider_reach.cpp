@@ -28,9 +28,14 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
         box.lo = grid.node_position(corner).array() - 2.5 * dx - reach;
         box.hi =
             grid.node_position(corner + Vec3i::Constant(kBlockSize)).array() + 2.5 * dx + reach;
+        // A collider (a ground plane's bounds are infinite) farther from the box's centre
+        // than its half diagonal plus reach cannot have a point of it within reach.
+        const Vec3d centre = 0.5 * (box.lo + box.hi);
+        const double radius = 0.5 * (box.hi - box.lo).norm();
         std::uint32_t near = 0;
         for (std::size_t k = 0; k < nk; ++k)
-          if (colliders[k].bounds().overlaps(box)) near |= 1u << k;
+          if (colliders[k].bounds().overlaps(box) && colliders[k].phi(centre) <= radius + reach)
+            near |= 1u << k;
         if (!near) return;
         for (std::uint32_t s = grid.pblock_start[b]; s < grid.pblock_start[b + 1]; ++s) {
           const std::uint32_t i = grid.order[s];

@@ -241,7 +241,10 @@ double GridShellTerms::collider_penalty(Shell& S, bool grad, std::vector<Mat3d>*
     if (S.held[j] == 7u) continue;
     const double kappa =
         kColliderPenalty * std::max(static_cast<double>(sh.mass[j]) / (dt_ * dt_), S.membrane);
+    Aabb at;
+    at.lo = at.hi = S.X[j];
     for (const Collider& col : *colliders_) {
+      if (!col.bounds().overlaps(at)) continue;
       const double phi = col.phi(S.X[j]);
       if (!(phi < 0)) continue;
       e += 0.5 * kappa * phi * phi;

@@ -1,6 +1,7 @@
 #include "sim/mpm/stress_batch.h"
 
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
@@ -22,9 +23,15 @@ SimdLevel from_environment(SimdLevel best) {
   const char* e = std::getenv("SHELLMPM_SIMD");
   if (!e) return best;
   SimdLevel want = best;
-  if (std::strcmp(e, "sse") == 0) want = SimdLevel::Sse;
-  if (std::strcmp(e, "avx2") == 0) want = SimdLevel::Avx2;
-  if (std::strcmp(e, "avx512") == 0) want = SimdLevel::Avx512;
+  if (std::strcmp(e, "sse") == 0)
+    want = SimdLevel::Sse;
+  else if (std::strcmp(e, "avx2") == 0)
+    want = SimdLevel::Avx2;
+  else if (std::strcmp(e, "avx512") == 0)
+    want = SimdLevel::Avx512;
+  else
+    std::fprintf(stderr, "shellmpm: SHELLMPM_SIMD='%s' is not one of sse, avx2, avx512; using %s\n",
+                 e, simd_name(best));
   return static_cast<int>(want) < static_cast<int>(best) ? want : best;
 }
 

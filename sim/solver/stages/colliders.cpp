@@ -11,7 +11,8 @@ bool CollidersStage::needed(const Scene& s) {
 
 void CollidersStage::run(StepContext& c) {
   for (Collider& col : c.colliders) col.begin_step(c.time, c.dt);
-  c.compute_collider_reach();
+  // The implicit grid stage has marked the reach for the step it took (c.dt) already.
+  if (c.scene.shot.integrator != Integrator::Implicit) c.compute_collider_reach();
   const double dx = c.grid.dx();
   parallel_for_each(
       c.grid.num_grid_blocks(), 16,
