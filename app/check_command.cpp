@@ -98,12 +98,16 @@ void print_time(const Solver& solver, const RunMemory& mem) {
   const ShotSettings& s = solver.scene().shot;
   if (s.integrator == Integrator::Implicit) {
     // No wave-speed bound: the step follows motion, the frame and the Newton solves.
+    char method[64] = "backward Euler";
+    if (s.implicit_theta < 1)
+      std::snprintf(method, sizeof method, "theta method, theta %g, for shells without contact",
+                    s.implicit_theta);
     std::printf(
-        "integrator: implicit (backward Euler, Newton with PCG, %s preconditioner): steps of "
+        "integrator: implicit (%s, Newton with PCG, %s preconditioner): steps of "
         "up to dt_max = %.3g s (%.3g per frame), shortened where cfl dx / max speed is "
         "smaller and halved where a Newton solve does not converge to %g m/s in %d "
         "iterations; the time per frame depends on those solves (stats.json: implicit)\n",
-        word_of(s.implicit_preconditioner).c_str(), s.dt_max, s.dt_max * s.fps,
+        method, word_of(s.implicit_preconditioner).c_str(), s.dt_max, s.dt_max * s.fps,
         s.implicit_tolerance, s.newton_max_iterations);
     (void)mem;
     return;

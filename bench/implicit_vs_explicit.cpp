@@ -18,7 +18,7 @@
 // static shape of its plastic state after the ball has left).
 //
 //   implicit_vs_explicit [--frames F] [--threads 1,2] [--explicit-frames E]
-//                        [--no-dent | --dent-only]
+//                        [--no-dent | --dent-only] [--no-grid-dent]
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -140,11 +140,19 @@ void run(const Case& c, int steps_per_frame, int frames, int threads) {
       t.per_step(t.newton), t.per_step(t.cg), t.retries, deflections.c_str());
 }
 
-/// scenes/steel_dent.yaml over its two moving frames with dt_max (0: explicit at CFL cfl).
-void dent(double dt_max, double cfl, int threads) {
+/// scenes/steel_dent.yaml with dt_max (0: explicit at CFL cfl). With contact on the grid
+/// (`direct` false): its two moving 240 fps frames. Without (`direct`: the control points
+/// are the unknowns and meet the ball through the collider projection and penalty): one
+/// 24 fps frame, with the theta method's theta.
+void dent(double dt_max, double cfl, int threads, bool direct = false, double theta = 1) {
   Scene s = read_scene(std::string(SHELLMPM_SOURCE_DIR) + "/scenes/steel_dent.yaml");
   s.shot.cfl = cfl;
   s.shot.dt_min = std::min(s.shot.dt_min, 1e-8);
+  if (direct) {
+    s.shells[0].contact = ShellDesc::Contact::Off;
+    s.shot.fps = 24;
+    s.shot.implicit_theta = theta;
+  }
   if (dt_max > 0) {
     s.shot.integrator = Integrator::Implicit;
     s.shot.dt_max = dt_max;
@@ -153,7 +161,7 @@ void dent(double dt_max, double cfl, int threads) {
   Solver solver(s);
   Totals t;
   double plastic = 0;
-  const int frames = 2;
+  const int frames = direct ? 1 : 2;
   for (int f = 0; f < frames; ++f) {
     const shellmpm_bench::TimedAdvance r = shellmpm_bench::timed_advance(solver, 1.0 / s.shot.fps);
     t.add(r);
@@ -164,7 +172,9 @@ void dent(double dt_max, double cfl, int threads) {
   double low = 1e9;
   for (const Vec3& x : sh.x) low = std::min(low, static_cast<double>(x.y()));
   char what[64];
-  if (dt_max > 0)
+  if (dt_max > 0 && theta < 1)
+    std::snprintf(what, sizeof what, "implicit dt_max %.3g s theta %.2g", dt_max, theta);
+  else if (dt_max > 0)
     std::snprintf(what, sizeof what, "implicit dt_max %.3g s", dt_max);
   else
     std::snprintf(what, sizeof what, "explicit CFL %.3g", cfl);
@@ -179,13 +189,15 @@ void dent(double dt_max, double cfl, int threads) {
 
 int main(int argc, char** argv) {
   int frames = 6, explicit_frames = 2;
-  bool with_dent = true, dent_only = false;
+  bool with_dent = true, dent_only = false, grid_dent = true;
   int kept = 1;  // --no-dent takes no value: taken out before the value options
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-dent")
       with_dent = false;
     else if (std::string(argv[i]) == "--dent-only")
       dent_only = true;
+    else if (std::string(argv[i]) == "--no-grid-dent")
+      grid_dent = false;
     else
       argv[kept++] = argv[i];
   }
@@ -213,6 +225,13 @@ int main(int argc, char** argv) {
     }
   }
   if (!with_dent) return 0;
+  std::printf("steel dent without contact (scenes/steel_dent.yaml, contact: off, 24 fps):\n");
+  for (int t : threads) {
+    for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t, true);
+    for (const double theta : {1.0, 0.5})
+      for (const double dt : {1e-3, 2e-4, 1e-4}) dent(dt, 0.5, t, true, theta);
+  }
+  if (!grid_dent) return 0;
   std::printf("steel dent (scenes/steel_dent.yaml, contact on the grid, 240 fps):\n");
   for (int t : threads) {
     // The explicit reference at its stable step and at half of it (how far it has

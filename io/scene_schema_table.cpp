@@ -137,6 +137,11 @@ std::vector<KeySpec> build_schema() {
       Spec("shot.implicit_preconditioner", T::Enum)
           .to(&ShotSettings::implicit_preconditioner)
           .def("factorised"),
+      Spec("shot.implicit_theta", T::Number)
+          .to(&ShotSettings::implicit_theta)
+          .def("1")
+          .ge(0.5)
+          .le(1),
       Spec("shot.units", T::String).to(&ShotSettings::units).def("m").nonempty(),
       Spec("shot.on_integrity_failure", T::Enum)
           .to(&ShotSettings::on_integrity_failure)

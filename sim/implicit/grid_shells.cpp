@@ -233,27 +233,13 @@ double GridShellTerms::evaluate(bool grad) {
 }
 
 double GridShellTerms::collider_penalty(Shell& S, bool grad, std::vector<Mat3d>* K) const {
-  if (K) K->assign(S.X.size(), Mat3d::Zero());
-  if (!colliders_ || colliders_->empty()) return 0;
-  const ShellObject& sh = *S.gs->shell;
-  double e = 0;
-  for (std::size_t j = 0; j < S.X.size(); ++j) {
-    if (S.held[j] == 7u) continue;
-    const double kappa =
-        kColliderPenalty * std::max(static_cast<double>(sh.mass[j]) / (dt_ * dt_), S.membrane);
-    Aabb at;
-    at.lo = at.hi = S.X[j];
-    for (const Collider& col : *colliders_) {
-      if (!col.bounds().overlaps(at)) continue;
-      const double phi = col.phi(S.X[j]);
-      if (!(phi < 0)) continue;
-      e += 0.5 * kappa * phi * phi;
-      const Vec3d n = col.normal(S.X[j]);
-      if (grad) S.dX[j] += kappa * phi * n;
-      if (K) (*K)[j] += kappa * n * n.transpose();
-    }
-  }
-  return e;
+  ColliderPenaltyInput in;
+  in.colliders = colliders_;
+  in.mass = &S.gs->shell->mass;
+  in.held = &S.held;
+  in.dt = dt_;
+  in.membrane = S.membrane;
+  return shellmpm::collider_penalty(in, S.X, grad ? &S.dX : nullptr, K);
 }
 
 double GridShellTerms::energy(const std::vector<PadD>& vel) {

@@ -25,6 +25,7 @@
 
 #include "sim/collider/collider.h"
 #include "sim/contact/shell_transfer.h"
+#include "sim/implicit/collider_penalty.h"
 #include "sim/implicit/newton.h"
 #include "sim/shell/fd_stiffness.h"
 #include "sim/shell/kirchhoff_love.h"
@@ -32,9 +33,6 @@
 namespace shellmpm {
 
 using PadD = std::array<Vec3d, kPadNodes>;
-
-/// The collider penalty's stiffness over max(m / dt^2, E h) (set_colliders).
-constexpr double kColliderPenalty = 100.0;
 
 /// A grid shell's double Kirchhoff-Love copy (ShellObject::double_kl) and its coupling.
 struct GridShellKl {

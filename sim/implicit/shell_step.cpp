@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim/implicit/collider_penalty.h"
 #include "sim/shell/fd_stiffness.h"
 
 namespace shellmpm {
@@ -13,15 +14,19 @@ class ShellObjective final : public ImplicitObjective {
  public:
   ShellObjective(const KirchhoffLoveShellT<double>& kl,
                  const std::vector<std::vector<int>>& coupling, const ShellObject& sh,
-                 const Vec3d& gravity, double t, double dt, ImplicitPreconditioner pre, bool serial)
-      : kl_(kl), coupling_(coupling), dt_(dt), pre_(pre), serial_(serial) {
+                 const Vec3d& gravity, double t, double dt, double theta,
+                 ImplicitPreconditioner pre, bool serial, const std::vector<Collider>* colliders)
+      : kl_(kl), coupling_(coupling), dt_(dt), theta_(theta), pre_(pre), serial_(serial) {
     n_ = sh.size();
     x0_.resize(n_);
-    for (std::size_t i = 0; i < n_; ++i) x0_[i] = sh.x[i].cast<double>();
+    xb_.resize(n_);
+    for (std::size_t i = 0; i < n_; ++i) {
+      x0_[i] = sh.x[i].cast<double>();
+      xb_[i] = x0_[i] + dt * (1 - theta) * sh.v[i].cast<double>();
+    }
     sh.external_forces(gravity, x0_, fext_);
-    std::vector<std::uint8_t> held;
     std::vector<Vec3d> target;
-    sh.pin_targets(t, dt, held, target);
+    sh.pin_targets(t, dt, held_, target);
     u0_.resize(3 * n_);
     v0_.resize(3 * n_);
     m_.resize(3 * n_);
@@ -32,18 +37,38 @@ class ShellObjective final : public ImplicitObjective {
         m_[k] = static_cast<double>(sh.mass[i]);
         u0_[k] = static_cast<double>(sh.v[i][a]);
         v0_[k] = u0_[k];
-        if (held[i] & (1u << a)) {
+        if (held_[i] & (1u << a)) {
           fixed_[k] = 1;
-          u0_[k] = (target[i][a] - x0_[i][a]) / dt;
+          u0_[k] = (target[i][a] - xb_[i][a]) / (dt * theta);
         } else if (!(m_[k] > 0)) {
           fixed_[k] = 1;
         }
       }
     damping_ = sh.material().damping;
     beta_ = sh.material().stiffness_damping;
+    penalty_.colliders = colliders;
+    penalty_.mass = &sh.mass;
+    penalty_.held = &held_;
+    penalty_.dt = dt;
+    penalty_.membrane = sh.material().youngs_modulus * sh.material().thickness;
     Eigen::AlignedBox<double, 3> box;
     for (const Vec3d& p : x0_) box.extend(p);
     length_ = std::max(box.diagonal().norm(), 1e-12);
+    // The explicit share of the theta method: (1 - theta) of the forces at the start.
+    explicit_.setZero(3 * n_);
+    if (theta < 1) {
+      std::vector<Vec3d> fn(n_, Vec3d::Zero());
+      kl_.energy(x0_.data(), fn.data(), serial_);
+      for (std::size_t k = 0; k < 3 * n_; ++k) {
+        const double c = damping_ * m_[k] * v0_[k];
+        explicit_[k] = (1 - theta) * (fn[k / 3][static_cast<int>(k % 3)] - c);
+      }
+      if (beta_ > 0) {
+        VecXd kv0;
+        stiffness_damping(v0_, kv0);
+        explicit_ -= (1 - theta) * beta_ * kv0;
+      }
+    }
   }
 
   Eigen::Index size() const override { return static_cast<Eigen::Index>(3 * n_); }
@@ -51,31 +76,36 @@ class ShellObjective final : public ImplicitObjective {
   const std::vector<Vec3d>& start() const { return x0_; }
 
   double energy(const VecXd& u) override {
-    double e = kl_.energy(moved(u).data(), nullptr, serial_).total;
+    const std::vector<Vec3d> x = moved(u);
+    double e = kl_.energy(x.data(), nullptr, serial_).total +
+               collider_penalty(penalty_, x, nullptr, nullptr);
     for (std::size_t k = 0; k < 3 * n_; ++k) {
       const double du = u[k] - v0_[k];
-      e += 0.5 * m_[k] * (du * du + dt_ * damping_ * u[k] * u[k]) -
-           dt_ * fext_[k / 3][static_cast<int>(k % 3)] * u[k];
+      e += 0.5 * m_[k] * (du * du + dt_ * theta_ * damping_ * u[k] * u[k]) -
+           dt_ * (fext_[k / 3][static_cast<int>(k % 3)] + explicit_[k]) * u[k];
     }
     if (beta_ > 0) {
       stiffness_damping(u, kv_);
-      e += 0.5 * dt_ * beta_ * u.dot(kv_);
+      e += 0.5 * dt_ * theta_ * beta_ * u.dot(kv_);
     }
     return e;
   }
 
   void gradient(const VecXd& u, VecXd& g) override {
     f_.assign(n_, Vec3d::Zero());
-    kl_.energy(moved(u).data(), f_.data(), serial_);
+    const std::vector<Vec3d> x = moved(u);
+    kl_.energy(x.data(), f_.data(), serial_);
+    pen_grad_.assign(n_, Vec3d::Zero());
+    collider_penalty(penalty_, x, &pen_grad_, nullptr);
     g.resize(size());
     for (std::size_t k = 0; k < 3 * n_; ++k) {
       const int a = static_cast<int>(k % 3);
-      g[k] =
-          m_[k] * (u[k] - v0_[k] + dt_ * damping_ * u[k]) - dt_ * (fext_[k / 3][a] + f_[k / 3][a]);
+      g[k] = m_[k] * (u[k] - v0_[k] + dt_ * theta_ * damping_ * u[k]) -
+             dt_ * (fext_[k / 3][a] + explicit_[k] + theta_ * (f_[k / 3][a] - pen_grad_[k / 3][a]));
     }
     if (beta_ > 0) {
       stiffness_damping(u, kv_);
-      g += dt_ * beta_ * kv_;
+      g += dt_ * theta_ * beta_ * kv_;
     }
     project(g);
   }
@@ -103,9 +133,20 @@ class ShellObjective final : public ImplicitObjective {
     };
     SparseMatrixD A =
         fd_stiffness(forces, xs, f0, dof_of, dofs, coupling_, groups_, 1e-8 * length_);
-    A *= dt_ * dt_ + dt_ * beta_;
+    const double th = theta_;
+    A *= dt_ * dt_ * th * th + dt_ * th * beta_;
     for (std::size_t k = 0; k < 3 * n_; ++k)
-      if (dof_of[k] >= 0) A.coeffRef(dof_of[k], dof_of[k]) += m_[k] * (1 + dt_ * damping_);
+      if (dof_of[k] >= 0) A.coeffRef(dof_of[k], dof_of[k]) += m_[k] * (1 + dt_ * th * damping_);
+    std::vector<Mat3d> kc;
+    collider_penalty(penalty_, xs, nullptr, &kc);
+    for (std::size_t i = 0; i < n_; ++i) {
+      if (kc[i].isZero()) continue;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          const int ra = dof_of[3 * i + a], rb = dof_of[3 * i + b];
+          if (ra >= 0 && rb >= 0) A.coeffRef(ra, rb) += dt_ * dt_ * th * th * kc[i](a, b);
+        }
+    }
     if (pre_ == ImplicitPreconditioner::Factorised) {
       ldlt_ = factorise_positive(A);
       return;
@@ -118,7 +159,7 @@ class ShellObjective final : public ImplicitObjective {
       for (int a = 0; a < 3; ++a) {
         const int ra = dof_of[3 * i + a];
         if (ra < 0) continue;
-        mass = m_[3 * i + a] * (1 + dt_ * damping_);
+        mass = m_[3 * i + a] * (1 + dt_ * theta_ * damping_);
         for (int c = 0; c < 3; ++c) {
           const int rc = dof_of[3 * i + c];
           b(a, c) = rc >= 0 ? A.coeff(ra, rc) : (a == c ? 1.0 : 0.0);
@@ -157,7 +198,7 @@ class ShellObjective final : public ImplicitObjective {
 
   std::vector<Vec3d> moved(const VecXd& u) const {
     std::vector<Vec3d> x(n_);
-    for (std::size_t i = 0; i < n_; ++i) x[i] = x0_[i] + dt_ * u.segment<3>(3 * i);
+    for (std::size_t i = 0; i < n_; ++i) x[i] = xb_[i] + dt_ * theta_ * u.segment<3>(3 * i);
     return x;
   }
 
@@ -180,12 +221,14 @@ class ShellObjective final : public ImplicitObjective {
 
   const KirchhoffLoveShellT<double>& kl_;
   const std::vector<std::vector<int>>& coupling_;
-  double dt_, damping_ = 0, beta_ = 0, length_ = 1;
+  double dt_, theta_, damping_ = 0, beta_ = 0, length_ = 1;
   ImplicitPreconditioner pre_;
   bool serial_;
   std::size_t n_ = 0;
-  std::vector<Vec3d> x0_, fext_, f_;
-  VecXd u0_, v0_, m_, kv_;
+  std::vector<Vec3d> x0_, xb_, fext_, f_, pen_grad_;
+  std::vector<std::uint8_t> held_;
+  ColliderPenaltyInput penalty_;
+  VecXd u0_, v0_, m_, kv_, explicit_;
   std::vector<char> fixed_;
   std::vector<int> dof_of_;
   std::vector<std::vector<int>> groups_;
@@ -198,22 +241,22 @@ class ShellObjective final : public ImplicitObjective {
 ShellImplicitStep::ShellImplicitStep(const ShellObject& sh) : kl_(sh.double_kl(&coupling_)) {}
 ShellImplicitStep::~ShellImplicitStep() = default;
 
-std::unique_ptr<ImplicitObjective> ShellImplicitStep::objective(const ShellObject& sh,
-                                                                const Vec3d& gravity, double t,
-                                                                double dt,
-                                                                ImplicitPreconditioner pre,
-                                                                bool serial, VecXd& u0) {
+std::unique_ptr<ImplicitObjective> ShellImplicitStep::objective(
+    const ShellObject& sh, const Vec3d& gravity, double t, double dt, double theta,
+    ImplicitPreconditioner pre, bool serial, VecXd& u0, const std::vector<Collider>* colliders) {
   sh.sync_double_kl(*kl_);
-  auto obj = std::make_unique<ShellObjective>(*kl_, coupling_, sh, gravity, t, dt, pre, serial);
+  auto obj = std::make_unique<ShellObjective>(*kl_, coupling_, sh, gravity, t, dt, theta, pre,
+                                              serial, colliders);
   u0 = obj->initial();
   return obj;
 }
 
 NewtonReport ShellImplicitStep::step(ShellObject& sh, const Vec3d& gravity, double t, double dt,
-                                     const NewtonOptions& opt, ImplicitPreconditioner pre,
-                                     bool serial) {
+                                     double theta, const NewtonOptions& opt,
+                                     ImplicitPreconditioner pre, bool serial,
+                                     const std::vector<Collider>* colliders) {
   sh.sync_double_kl(*kl_);
-  ShellObjective obj(*kl_, coupling_, sh, gravity, t, dt, pre, serial);
+  ShellObjective obj(*kl_, coupling_, sh, gravity, t, dt, theta, pre, serial, colliders);
   VecXd u = obj.initial();
   NewtonReport rep = newton_minimise(obj, u, opt);
   if (!rep.converged) return rep;

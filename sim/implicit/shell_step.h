@@ -1,13 +1,18 @@
-// Backward Euler for a shell without contact (its control points are the unknowns; no
-// grid). One step from t to t + dt minimises over the control-point velocities u
-//   E(u) = sum_j m_j (|u_j - v_j^n|^2 + dt c |u_j|^2) / 2 - dt f_ext . u
-//          + Psi_KL(x^n + dt u) + dt beta u . K(x^n) u / 2
+// The theta method (theta 1: backward Euler; 1/2: the trapezoidal rule, which damps
+// nothing) for a shell without contact (its control points are the unknowns; no grid).
+// One step from t to t + dt minimises over the control-point velocities u, with
+// x(u) = x^n + dt ((1 - theta) v^n + theta u),
+//   E(u) = sum_j m_j (|u_j - v_j^n|^2 + dt theta c |u_j|^2) / 2 + Psi_KL(x(u))
+//          + dt theta beta u . K(x^n) u / 2 - dt (f_ext + (1 - theta) f^n) . u
 // (c: mass damping, beta: Rayleigh stiffness damping with K at the step's start, f_ext:
-// gravity, pressure and point loads at x^n), whose stationarity is
-//   m (u - v^n) = dt (f_KL(x^n + dt u) + f_ext - c m u - beta K u),
+// gravity, pressure and point loads at x^n, f^n = f_KL(x^n) - c m v^n - beta K v^n),
+// whose stationarity is
+//   m (u - v^n) = dt (f_ext + (1 - theta) f^n + theta (f_KL(x(u)) - c m u - beta K u)),
 // the implicit counterpart of ShellObject::integrate. Pinned components are constraints
 // (their velocity takes them to the pin pose at t + dt), as are points without mass.
 // Denting is applied after the step by the denting stage, as in the explicit path.
+// Colliders (posed for the step) add their penalty on the moved control points
+// (collider_penalty.h); the projection stage then puts the points on the surface.
 //
 // The Kirchhoff-Love energy is evaluated in double (ShellObject::double_kl); Hessian
 // products are central differences of the gradient (newton.h). Preconditioner: the
@@ -19,6 +24,7 @@
 #include <memory>
 #include <vector>
 
+#include "sim/collider/collider.h"
 #include "sim/implicit/newton.h"
 #include "sim/shell/shell_object.h"
 
@@ -31,13 +37,15 @@ class ShellImplicitStep {
 
   /// One step of sh from t to t + dt. On convergence writes sh.x and sh.v; otherwise
   /// leaves sh as it was. The report says which.
-  NewtonReport step(ShellObject& sh, const Vec3d& gravity, double t, double dt,
-                    const NewtonOptions& opt, ImplicitPreconditioner pre, bool serial);
+  NewtonReport step(ShellObject& sh, const Vec3d& gravity, double t, double dt, double theta,
+                    const NewtonOptions& opt, ImplicitPreconditioner pre, bool serial,
+                    const std::vector<Collider>* colliders = nullptr);
   /// The objective of that step (for tests), and in u0 its starting point (v^n, with
   /// the pinned components at their pin velocity).
   std::unique_ptr<ImplicitObjective> objective(const ShellObject& sh, const Vec3d& gravity,
-                                               double t, double dt, ImplicitPreconditioner pre,
-                                               bool serial, VecXd& u0);
+                                               double t, double dt, double theta,
+                                               ImplicitPreconditioner pre, bool serial, VecXd& u0,
+                                               const std::vector<Collider>* colliders = nullptr);
 
  private:
   std::vector<std::vector<int>> coupling_;  // before kl_: the constructor fills both

@@ -64,6 +64,9 @@ struct ShotSettings {
   int newton_max_iterations = 30;  ///< implicit: Newton iterations before a step is retried
   int cg_max_iterations = 500;     ///< implicit: CG iterations per Newton iteration
   ImplicitPreconditioner implicit_preconditioner = ImplicitPreconditioner::Factorised;
+  /// Implicit shells without contact: the theta method's weight of the end-of-step forces
+  /// (1: backward Euler, damps fast modes; 0.5: trapezoidal, damps nothing).
+  double implicit_theta = 1;
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
   enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;

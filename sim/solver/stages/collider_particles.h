@@ -1,6 +1,7 @@
 // Stage "collider_particles": Particle-level collider projection after advection
 // (particle_projection.h): bulk particles and free control points inside a collider go to its
-// surface.
+// surface. The control points of shells without contact (no grid) too: colliders reach
+// them only here (and, implicit, through the step's penalty, collider_penalty.h).
 #pragma once
 #include "sim/solver/stages/stage.h"
 

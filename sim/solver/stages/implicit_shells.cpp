@@ -30,10 +30,13 @@ void ImplicitShellsStage::advance(StepContext& c, double t, double dt) {
       v0[i] = c.shells[i]->v;
     }
   const NewtonOptions opt = newton_options(shot);
+  // The colliders at this (sub)step's end; the collider stages pose them again for theirs.
+  for (Collider& col : c.colliders) col.begin_step(t, dt);
   for (std::size_t i = 0; i < c.shells.size(); ++i) {
     if (!steps_[i]) continue;
-    const NewtonReport rep = steps_[i]->step(*c.shells[i], shot.gravity, t, dt, opt,
-                                             shot.implicit_preconditioner, c.opt.serial);
+    const NewtonReport rep =
+        steps_[i]->step(*c.shells[i], shot.gravity, t, dt, shot.implicit_theta, opt,
+                        shot.implicit_preconditioner, c.opt.serial, &c.colliders);
     c.implicit_frame.add(rep.iterations, rep.cg_iterations, rep.residual);
     if (rep.converged) continue;
     // Every shell back to the start, then the step in two halves.

@@ -78,6 +78,8 @@ double total_energy(const ShellObject& sh, const Vec3d& g) {
 }  // namespace
 
 TEST_CASE("implicit shell: the objective's gradient matches finite differences", "[implicit]") {
+  const double theta = GENERATE(1.0, 0.6);  // backward Euler, and the theta method
+  CAPTURE(theta);
   Scene s = cantilever_scene();
   s.shell_materials[0].damping = 2.0;
   s.shell_materials[0].stiffness_damping = 1e-4;
@@ -90,14 +92,31 @@ TEST_CASE("implicit shell: the objective's gradient matches finite differences",
     sh.x[i].y() -= static_cast<Real>(0.05 * x * x);
     sh.v[i] = Vec3(Real(0.1 * std::sin(20 * x)), Real(-0.3 * x), Real(0.05));
   }
+  // A ball whose surface cuts the strip's tip, so the collider penalty acts on some of
+  // the moved control points (and not on others).
+  ColliderDesc ball;
+  ball.name = "ball";
+  ball.shape.kind = ShapeDesc::Kind::Sphere;
+  ball.shape.center = Vec3d(0.2, 0.03, 0);
+  ball.shape.radius = 0.04;
+  std::vector<Collider> colliders{Collider(ball)};
+  colliders[0].begin_step(0.0, 1.0 / 24);
   ShellImplicitStep step(sh);
   VecXd u0;
-  const auto obj = step.objective(sh, s.shot.gravity, 0.0, 1.0 / 24,
-                                  ImplicitPreconditioner::Factorised, true, u0);
+  const auto obj = step.objective(sh, s.shot.gravity, 0.0, 1.0 / 24, theta,
+                                  ImplicitPreconditioner::Factorised, true, u0, &colliders);
   VecXd u = u0, d(u0.size()), g;
   for (Eigen::Index k = 0; k < u.size(); ++k) d[k] = std::cos(0.7 * k);
   obj->project(d);
   u += 0.01 * d;
+  int inside = 0;
+  for (std::size_t i = 0; i < sh.size(); ++i)
+    if (colliders[0].phi(sh.x[i].cast<double>() +
+                         ((1 - theta) * sh.v[i].cast<double>() + theta * u.segment<3>(3 * i)) /
+                             24) < 0)
+      ++inside;
+  CHECK(inside > 0);
+  CHECK(inside < static_cast<int>(sh.size()) / 2);
   obj->gradient(u, g);
   const double slope = g.dot(d);
   double prev_err = 1e300;
@@ -279,4 +298,53 @@ TEST_CASE("implicit shell: the same bits with and without threads, and from a re
   a.advance_to(4 / 24.0);
   c.advance_to(4 / 24.0);
   for (std::size_t i = 0; i < sa.size(); ++i) REQUIRE(sa.x[i] == sc.x[i]);
+}
+
+TEST_CASE("implicit shell: theta 1/2 is second order in time and keeps the energy", "[implicit]") {
+  // The cantilever released flat under gravity swings about its static shape (first
+  // mode about 8 Hz). Errors against a fine trapezoidal run halve with the step for
+  // backward Euler and fall four times for theta 1/2.
+  const double t_end = 0.1;
+  auto run = [&](double theta, double dt) {
+    Scene s = implicit(cantilever_scene(), dt, 1e-9);
+    s.shot.implicit_theta = theta;
+    Solver solver(s);
+    solver.advance_to(t_end);
+    return solver.shells()[0]->x;
+  };
+  const std::vector<Vec3> ref = run(0.5, t_end / 256);
+  auto error = [&](const std::vector<Vec3>& x) {
+    double e = 0;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      e = std::max(e, static_cast<double>((x[i] - ref[i]).norm()));
+    return e;
+  };
+  const double be1 = error(run(1.0, t_end / 16)), be2 = error(run(1.0, t_end / 32));
+  const double tr1 = error(run(0.5, t_end / 16)), tr2 = error(run(0.5, t_end / 32));
+  INFO("backward Euler " << be1 << " " << be2 << ", theta 1/2 " << tr1 << " " << tr2);
+  CHECK(be1 / be2 > 1.6);
+  CHECK(be1 / be2 < 2.6);
+  CHECK(tr1 / tr2 > 3.2);
+  CHECK(tr2 < 0.2 * be2);
+
+  // Over four periods at 1/240 s (30 steps a period) backward Euler takes most of the
+  // swing's energy out; theta 1/2 keeps it.
+  auto swing = [&](double theta) {
+    Scene s = implicit(cantilever_scene(), 1.0 / 240, 1e-9);
+    s.shot.implicit_theta = theta;
+    Solver solver(s);
+    ShellObject& sh = *solver.shells()[0];
+    const double e0 = total_energy(sh, s.shot.gravity);
+    sh.settle(s.shot.gravity, 0.0, 1e-12, 4000, false);
+    const double e_static = total_energy(sh, s.shot.gravity);
+    Solver again(s);
+    again.advance_to(0.5);
+    // The share of the swing's energy (above the static state) that is left.
+    return (total_energy(*again.shells()[0], s.shot.gravity) - e_static) / (e0 - e_static);
+  };
+  const double kept_be = swing(1.0), kept_tr = swing(0.5);
+  INFO("swing energy kept: backward Euler " << kept_be << ", theta 1/2 " << kept_tr);
+  CHECK(kept_be < 0.5);
+  CHECK(kept_tr > 0.98);
+  CHECK(kept_tr < 1.01);
 }
