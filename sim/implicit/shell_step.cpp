@@ -5,18 +5,37 @@
 #include <cmath>
 
 #include "sim/implicit/collider_penalty.h"
-#include "sim/shell/fd_stiffness.h"
+#include "sim/shell/kl_stiffness.h"
 
 namespace shellmpm {
+namespace {}  // namespace
+
+/// The finite-difference stiffness of the last step's preconditioner, for the next steps.
+struct ShellImplicitStep::StiffnessCache {
+  std::shared_ptr<const SparseMatrixD> K;  ///< -df/dx over the free components (numbering below)
+  std::vector<int> dof_of;                 ///< the numbering it was assembled with
+  bool valid = false;
+};
+
 namespace {
 
 class ShellObjective final : public ImplicitObjective {
  public:
+  /// cache: where the stiffness is kept between steps; reuse: the first preconditioner
+  /// of this step may take it from there (when the free components are the same).
   ShellObjective(const KirchhoffLoveShellT<double>& kl,
                  const std::vector<std::vector<int>>& coupling, const ShellObject& sh,
                  const Vec3d& gravity, double t, double dt, double theta,
-                 ImplicitPreconditioner pre, bool serial, const std::vector<Collider>* colliders)
-      : kl_(kl), coupling_(coupling), dt_(dt), theta_(theta), pre_(pre), serial_(serial) {
+                 ImplicitPreconditioner pre, bool serial, const std::vector<Collider>* colliders,
+                 ShellImplicitStep::StiffnessCache* cache = nullptr, bool reuse = false)
+      : kl_(kl),
+        coupling_(coupling),
+        dt_(dt),
+        theta_(theta),
+        pre_(pre),
+        serial_(serial),
+        cache_(cache),
+        reuse_(reuse) {
     n_ = sh.size();
     x0_.resize(n_);
     xb_.resize(n_);
@@ -117,28 +136,42 @@ class ShellObjective final : public ImplicitObjective {
     ldlt_.reset();
     std::vector<int> dof_of(3 * n_, -1);
     int dofs = 0;
-    std::vector<char> movable(n_, 0);
     for (std::size_t k = 0; k < 3 * n_; ++k)
       if (!fixed_[k]) {
         dof_of[k] = dofs++;
-        movable[k / 3] = 1;
       }
     dof_of_ = dof_of;
-    if (groups_.empty()) groups_ = colour_points(coupling_, movable);
+    if (reuse_ && cache_ && cache_->valid && cache_->dof_of == dof_of) {
+      reused_ = true;
+      K_ = cache_->K;
+    } else {
+      K_.reset();
+      K_ = std::make_shared<const SparseMatrixD>(
+          kl_stiffness_matrix(kl_, moved(u), dof_of, dofs, serial_));
+      ++assembled_;
+      if (cache_) {
+        cache_->K = K_;
+        cache_->dof_of = dof_of;
+        cache_->valid = true;
+      }
+    }
+    reuse_ = false;  // a refresh within the solve assembles afresh
+    build_preconditioner(u);
+  }
+
+  /// The preconditioner from the stiffness K_ (assembled or taken from the cache), with
+  /// the step's dt, mass and damping and the collider penalty's Hessian at u.
+  void build_preconditioner(const VecXd& u) {
+    const std::vector<int>& dof_of = dof_of_;
     const std::vector<Vec3d> xs = moved(u);
-    std::vector<Vec3d> f0(n_, Vec3d::Zero());
-    kl_.energy(xs.data(), f0.data(), serial_);
-    const PointForceFn forces = [this](const std::vector<Vec3d>& p, std::vector<Vec3d>& f) {
-      kl_.energy(p.data(), f.data(), serial_);
-    };
-    SparseMatrixD A =
-        fd_stiffness(forces, xs, f0, dof_of, dofs, coupling_, groups_, 1e-8 * length_);
+    std::vector<Mat3d> kc;
+    collider_penalty(penalty_, xs, nullptr, &kc);
+    ldlt_.reset();
+    SparseMatrixD A = *K_;
     const double th = theta_;
     A *= dt_ * dt_ * th * th + dt_ * th * beta_;
     for (std::size_t k = 0; k < 3 * n_; ++k)
       if (dof_of[k] >= 0) A.coeffRef(dof_of[k], dof_of[k]) += m_[k] * (1 + dt_ * th * damping_);
-    std::vector<Mat3d> kc;
-    collider_penalty(penalty_, xs, nullptr, &kc);
     for (std::size_t i = 0; i < n_; ++i) {
       if (kc[i].isZero()) continue;
       for (int a = 0; a < 3; ++a)
@@ -196,6 +229,10 @@ class ShellObjective final : public ImplicitObjective {
       if (fixed_[k]) d[k] = 0;
   }
 
+  /// Whether the solve started from the cached stiffness, and how often it assembled one.
+  bool reused() const { return reused_; }
+  int assembled() const { return assembled_; }
+
   std::vector<Vec3d> moved(const VecXd& u) const {
     std::vector<Vec3d> x(n_);
     for (std::size_t i = 0; i < n_; ++i) x[i] = xb_[i] + dt_ * theta_ * u.segment<3>(3 * i);
@@ -224,6 +261,10 @@ class ShellObjective final : public ImplicitObjective {
   double dt_, theta_, damping_ = 0, beta_ = 0, length_ = 1;
   ImplicitPreconditioner pre_;
   bool serial_;
+  ShellImplicitStep::StiffnessCache* cache_;
+  bool reuse_, reused_ = false;
+  int assembled_ = 0;  ///< finite-difference stiffness assemblies in this solve
+  std::shared_ptr<const SparseMatrixD> K_;
   std::size_t n_ = 0;
   std::vector<Vec3d> x0_, xb_, fext_, f_, pen_grad_;
   std::vector<std::uint8_t> held_;
@@ -231,14 +272,14 @@ class ShellObjective final : public ImplicitObjective {
   VecXd u0_, v0_, m_, kv_, explicit_;
   std::vector<char> fixed_;
   std::vector<int> dof_of_;
-  std::vector<std::vector<int>> groups_;
   std::unique_ptr<SparseLdlt> ldlt_;
   std::vector<Mat3d> blocks_;
 };
 
 }  // namespace
 
-ShellImplicitStep::ShellImplicitStep(const ShellObject& sh) : kl_(sh.double_kl(&coupling_)) {}
+ShellImplicitStep::ShellImplicitStep(const ShellObject& sh)
+    : kl_(sh.double_kl(&coupling_)), cache_(std::make_unique<StiffnessCache>()) {}
 ShellImplicitStep::~ShellImplicitStep() = default;
 
 std::unique_ptr<ImplicitObjective> ShellImplicitStep::objective(
@@ -254,18 +295,42 @@ std::unique_ptr<ImplicitObjective> ShellImplicitStep::objective(
 NewtonReport ShellImplicitStep::step(ShellObject& sh, const Vec3d& gravity, double t, double dt,
                                      double theta, const NewtonOptions& opt,
                                      ImplicitPreconditioner pre, bool serial,
-                                     const std::vector<Collider>* colliders) {
+                                     const std::vector<Collider>* colliders, std::uint64_t epoch) {
   sh.sync_double_kl(*kl_);
-  ShellObjective obj(*kl_, coupling_, sh, gravity, t, dt, theta, pre, serial, colliders);
-  VecXd u = obj.initial();
-  NewtonReport rep = newton_minimise(obj, u, opt);
-  if (!rep.converged) return rep;
-  const std::vector<Vec3d> x = obj.moved(u);
-  for (std::size_t i = 0; i < sh.size(); ++i) {
-    sh.x[i] = x[i].cast<Real>();
-    sh.v[i] = u.segment<3>(3 * i).cast<Real>();
+  if (epoch != epoch_) cache_->valid = false;
+  epoch_ = epoch;
+  bool reuse = cache_->valid && age_ < kMaxStiffnessAge;
+  NewtonReport total;
+  for (;;) {
+    ShellObjective obj(*kl_, coupling_, sh, gravity, t, dt, theta, pre, serial, colliders,
+                       cache_.get(), reuse);
+    VecXd u = obj.initial();
+    NewtonReport rep = newton_minimise(obj, u, opt);
+    rep.iterations += total.iterations;
+    rep.cg_iterations += total.cg_iterations;
+    total = rep;
+    const double per_newton = static_cast<double>(rep.cg_iterations) / std::max(rep.iterations, 1);
+    if (obj.reused()) ++reused_steps_;
+    if (obj.assembled() > 0) {
+      age_ = 0;  // the cache holds this step's stiffness
+      if (!obj.reused()) fresh_cg_per_newton_ = per_newton;
+    } else {
+      ++age_;
+      // A stale stiffness that costs CG iterations (or the solve) is assembled afresh.
+      if (per_newton > 2 * fresh_cg_per_newton_ + 4) cache_->valid = false;
+      if (!rep.converged) {
+        reuse = false;
+        continue;  // again with the stiffness at this state
+      }
+    }
+    if (!rep.converged) return rep;
+    const std::vector<Vec3d> x = obj.moved(u);
+    for (std::size_t i = 0; i < sh.size(); ++i) {
+      sh.x[i] = x[i].cast<Real>();
+      sh.v[i] = u.segment<3>(3 * i).cast<Real>();
+    }
+    return rep;
   }
-  return rep;
 }
 
 }  // namespace shellmpm

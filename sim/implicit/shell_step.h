@@ -19,8 +19,15 @@
 // tangent M (1 + dt c) + (dt^2 + dt beta) K assembled by finite differences of the forces
 // (fd_stiffness.h) at the start of the step and factorised (`factorised`, CG then takes a
 // few iterations per Newton step), or its 3x3 diagonal blocks (`block_jacobi`, no
-// factorisation; many more CG iterations on stiff sheets).
+// factorisation; many more CG iterations on stiff sheets). The finite-difference
+// stiffness (most of a short step's cost) is kept for the next steps of the same epoch
+// (the solver's advance: a resume starts a new one, so it reproduces the run) and the
+// preconditioner rebuilt from it with the step's dt, mass and collider terms; it is
+// assembled afresh after kMaxStiffnessAge steps, when a step needs more than twice the
+// CG iterations per Newton iteration of the last fresh one (plus 4), and when a solve
+// with it does not converge (that step is then solved again with a fresh one).
 #pragma once
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -32,6 +39,9 @@ namespace shellmpm {
 
 class ShellImplicitStep {
  public:
+  struct StiffnessCache;
+  static constexpr int kMaxStiffnessAge = 20;
+
   explicit ShellImplicitStep(const ShellObject& sh);
   ~ShellImplicitStep();
 
@@ -39,7 +49,9 @@ class ShellImplicitStep {
   /// leaves sh as it was. The report says which.
   NewtonReport step(ShellObject& sh, const Vec3d& gravity, double t, double dt, double theta,
                     const NewtonOptions& opt, ImplicitPreconditioner pre, bool serial,
-                    const std::vector<Collider>* colliders = nullptr);
+                    const std::vector<Collider>* colliders = nullptr, std::uint64_t epoch = 0);
+  /// Steps whose preconditioner reused an earlier step's stiffness (for tests).
+  long reused_steps() const { return reused_steps_; }
   /// The objective of that step (for tests), and in u0 its starting point (v^n, with
   /// the pinned components at their pin velocity).
   std::unique_ptr<ImplicitObjective> objective(const ShellObject& sh, const Vec3d& gravity,
@@ -50,6 +62,11 @@ class ShellImplicitStep {
  private:
   std::vector<std::vector<int>> coupling_;  // before kl_: the constructor fills both
   std::unique_ptr<KirchhoffLoveShellT<double>> kl_;
+  std::unique_ptr<StiffnessCache> cache_;
+  std::uint64_t epoch_ = 0;
+  int age_ = 0;  ///< steps since the cached stiffness was assembled
+  long reused_steps_ = 0;
+  double fresh_cg_per_newton_ = 0;
 };
 
 }  // namespace shellmpm

@@ -183,9 +183,15 @@ void KirchhoffLoveShellT<T>::set_plastic_state(const std::vector<T>& state) {
 template <class T>
 void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, double& e_total,
                                         double& e_membrane) const {
-  using V3 = Vec3T;
   PointKinematics<T> k;
   gather_kinematics(begin_, ctrl_, coef_, q, x, k);
+  eval_kinematics(q, k, grad, e_total, &e_membrane);
+}
+
+template <class T>
+void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinematics<T>& k,
+                                             T* grad, double& e_total, double* e_membrane) const {
+  using V3 = Vec3T;
 
   const bool plastic = !fp_inv_.empty();
   const T area = area_[q];
@@ -221,7 +227,7 @@ void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, 
     }
   }
   e_total += double(energy);
-  {  // membrane diagnostic: mid-surface layer (xi3 = 0), whole thickness
+  if (e_membrane) {  // membrane diagnostic: mid-surface layer (xi3 = 0), whole thickness
     const T* B0 = &B0_[4 * q];
     T Bp0[4];
     if (plastic) {
@@ -229,9 +235,9 @@ void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, 
       mul2(B0, fp_mean, Bp0);
       B0 = Bp0;
     }
-    e_membrane += double(area * thickness_ *
-                         layer_psi(mu_, lambda_, stiffening_, B0, k.a1.dot(k.a1), k.a1.dot(k.a2),
-                                   k.a2.dot(k.a2), static_cast<T*>(nullptr)));
+    *e_membrane += double(area * thickness_ *
+                          layer_psi(mu_, lambda_, stiffening_, B0, k.a1.dot(k.a1), k.a1.dot(k.a2),
+                                    k.a2.dot(k.a2), static_cast<T*>(nullptr)));
   }
   if (!grad) return;
 

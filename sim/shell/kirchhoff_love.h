@@ -62,6 +62,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "sim/core/types.h"
@@ -126,6 +127,18 @@ class KirchhoffLoveShellT {
   /// yield_stress == 0; a layer below yield is left bitwise unchanged.
   T project_plasticity(const Vec3T* x, bool serial = false);
 
+  /// The stiffness d^2E/dx^2 at x as 3x3 blocks per coupled pair of control points: for
+  /// each (i, j) of a quadrature point's entries, add(i, j, block) is called (in a fixed
+  /// order; the same pair comes from several points, and add must sum). Each point's
+  /// energy depends on x only through (a_1, a_2, a_11, a_12, a_22), linear in x, so its
+  /// Hessian is J^T H J with H (15 x 15) from forward differences of the point's exact
+  /// adjoints (step h_rel |a_alpha|, symmetrised): 16 point evaluations, where finite
+  /// differences of the whole force field take one force evaluation per colour and axis
+  /// (150 on a Loop sheet). Double only.
+  void stiffness_blocks(const Vec3T* x, double h_rel,
+                        const std::function<void(int, int, const Eigen::Matrix<T, 3, 3>&)>& add,
+                        bool serial = false) const;
+
   /// Largest |log s_a| (principal elastic Hencky strain, either sign) over all
   /// quadrature points and layers.
   T max_strain(const Vec3T* x, bool serial = false) const;
@@ -167,6 +180,10 @@ class KirchhoffLoveShellT {
   // (15 values); returns energy and membrane energy.
   void eval_point(std::size_t q, const Vec3T* x, T* grad, double& e_total,
                   double& e_membrane) const;
+  /// The same from point q's kinematics (without the membrane diagnostic where
+  /// e_membrane is null).
+  void eval_kinematics(std::size_t q, const kl::PointKinematics<T>& k, T* grad, double& e_total,
+                       double* e_membrane) const;
 
   /// The large-stretch term: s_l, log s_l and k.
   struct Stiffening {

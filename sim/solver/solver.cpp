@@ -197,6 +197,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   for (Slot& st : stages_) st.seconds = 0;
   c_.guard_frame = ShellGuardStats{};
   c_.implicit_frame = ImplicitStats{};
+  ++c_.advance_epoch;
   FrameStats fs;
   fs.dt_min = std::numeric_limits<double>::infinity();
   double dt_seconds = 0, integrity_seconds = 0;

@@ -41,6 +41,9 @@ struct StepContext {
   // Time. The solver writes them before each step; stages read them.
   double time = 0;  ///< at the start of the step [s]
   double dt = 0;    ///< of this step [s]
+  /// Counts the solver's advances (Solver::advance_to): state a stage keeps between steps
+  /// only within one advance (a cache) is the same on a re-run and on a resume.
+  std::uint64_t advance_epoch = 0;
 
   // Sources and colliders. emit writes the samplers' emission state; colliders poses
   // each collider for the step (read by collider_particles and the walls check).
