@@ -81,12 +81,7 @@ Case steel_sheet() {
   m.density = 7850;
   m.thickness = 5e-4;
   c.scene.shell_materials.push_back(m);
-  ShellDesc sh;
-  sh.name = "sheet";
-  sh.contact = ShellDesc::Contact::Off;
-  sh.kind = ShellDesc::Kind::Sheet;
-  sh.size[0] = sh.size[1] = 0.2;
-  sh.resolution[0] = sh.resolution[1] = 16;
+  ShellDesc sh = shellmpm::test::free_sheet("sheet", 0.2, 16);
   sh.pressure = 200;
   for (const double x : {-0.1, 0.1}) {
     PinDesc edge;

@@ -39,6 +39,27 @@ inline ShellDesc clamped_strip(const std::string& name) {
   return sh;
 }
 
+/// A square sheet without contact: side `size` [m], `resolution` elements a side.
+inline ShellDesc free_sheet(const std::string& name, double size, int resolution) {
+  ShellDesc sh;
+  sh.name = name;
+  sh.contact = ShellDesc::Contact::Off;
+  sh.kind = ShellDesc::Kind::Sheet;
+  sh.size[0] = sh.size[1] = size;
+  sh.resolution[0] = sh.resolution[1] = resolution;
+  return sh;
+}
+
+/// A still sphere collider.
+inline ColliderDesc sphere_collider(const std::string& name, const Vec3d& center, double radius) {
+  ColliderDesc c;
+  c.name = name;
+  c.shape.kind = ShapeDesc::Kind::Sphere;
+  c.shape.center = center;
+  c.shape.radius = radius;
+  return c;
+}
+
 /// A scene for contact tests: grid spacing dx, CFL 0.5, 48 fps, the domain [-1, 1]^3.
 inline Scene contact_test_scene(double dx) {
   Scene s;

@@ -10,6 +10,7 @@
 #include "sim/mpm/transfer.h"
 #include "sim/shell/shell_object.h"
 #include "sim/solver/solver.h"
+#include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;
 
@@ -166,12 +167,7 @@ TEST_CASE(
   Rig rig;
   const double dt = 0.01;
   // A ball pressing into the sheet from above: some control points start inside it.
-  ColliderDesc cd;
-  cd.name = "ball";
-  cd.shape.kind = ShapeDesc::Kind::Sphere;
-  cd.shape.center = Vec3d(0.03, 0.49, 0.0);
-  cd.shape.radius = 0.08;
-  std::vector<Collider> cols{Collider(cd)};
+  std::vector<Collider> cols{Collider(test::sphere_collider("ball", Vec3d(0.03, 0.49, 0.0), 0.08))};
   cols[0].begin_step(0, dt);
   std::size_t inside = 0;
   for (const Vec3& x : rig.shell->x) inside += cols[0].phi(x.cast<double>()) < 0;

@@ -95,12 +95,8 @@ TEST_CASE("implicit shell: the objective's gradient matches finite differences",
   }
   // A ball whose surface cuts the strip's tip, so the collider penalty acts on some of
   // the moved control points (and not on others).
-  ColliderDesc ball;
-  ball.name = "ball";
-  ball.shape.kind = ShapeDesc::Kind::Sphere;
-  ball.shape.center = Vec3d(0.2, 0.03, 0);
-  ball.shape.radius = 0.04;
-  std::vector<Collider> colliders{Collider(ball)};
+  std::vector<Collider> colliders{
+      Collider(test::sphere_collider("ball", Vec3d(0.2, 0.03, 0), 0.04))};
   colliders[0].begin_step(0.0, 1.0 / 24);
   ShellImplicitStep step(sh);
   VecXd u0;
