@@ -198,7 +198,7 @@ double GridShellTerms::evaluate(bool grad) {
     const ShellObject& sh = *S.gs->shell;
     const std::size_t n = S.X.size();
     if (grad) S.f.assign(n, Vec3d::Zero());
-    e += S.kl->kl->energy(S.X.data(), grad ? S.f.data() : nullptr, serial_).total;
+    e += S.kl->kl->energy(S.X.data(), grad ? S.f.data() : nullptr, serial_, false).total;
     // Contact particles: energy, and their dpsi/da_beta (G1, G2) and dpsi/da3E.
     const std::uint32_t s0 = site_start_[s];
     const std::size_t ns = c.num_sites();
@@ -407,7 +407,7 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
     const std::vector<std::vector<int>>& coupling = S.kl->coupling;
     const std::vector<std::vector<int>> groups = colour_points(coupling, movable);
     const PointForceFn forces = [this, s](const std::vector<Vec3d>& p, std::vector<Vec3d>& f) {
-      sh_[s].kl->kl->energy(p.data(), f.data(), serial_);
+      sh_[s].kl->kl->energy(p.data(), f.data(), serial_, false);
       contact_forces(s, p, f);
     };
     std::vector<Vec3d> f0(n, Vec3d::Zero());

@@ -77,7 +77,7 @@ class ShellObjective final : public ImplicitObjective {
     explicit_.setZero(3 * n_);
     if (theta < 1) {
       std::vector<Vec3d> fn(n_, Vec3d::Zero());
-      kl_.energy(x0_.data(), fn.data(), serial_);
+      kl_.energy(x0_.data(), fn.data(), serial_, false);
       for (std::size_t k = 0; k < 3 * n_; ++k) {
         const double c = damping_ * m_[k] * v0_[k];
         explicit_[k] = (1 - theta) * (fn[k / 3][static_cast<int>(k % 3)] - c);
@@ -96,7 +96,7 @@ class ShellObjective final : public ImplicitObjective {
 
   double energy(const VecXd& u) override {
     const std::vector<Vec3d> x = moved(u);
-    double e = kl_.energy(x.data(), nullptr, serial_).total +
+    double e = kl_.energy(x.data(), nullptr, serial_, false).total +
                collider_penalty(penalty_, x, nullptr, nullptr);
     for (std::size_t k = 0; k < 3 * n_; ++k) {
       const double du = u[k] - v0_[k];
@@ -113,7 +113,7 @@ class ShellObjective final : public ImplicitObjective {
   void gradient(const VecXd& u, VecXd& g) override {
     f_.assign(n_, Vec3d::Zero());
     const std::vector<Vec3d> x = moved(u);
-    kl_.energy(x.data(), f_.data(), serial_);
+    kl_.energy(x.data(), f_.data(), serial_, false);
     pen_grad_.assign(n_, Vec3d::Zero());
     collider_penalty(penalty_, x, &pen_grad_, nullptr);
     g.resize(size());
@@ -251,8 +251,8 @@ class ShellObjective final : public ImplicitObjective {
       xp[i] = x0_[i] + h * u.segment<3>(3 * i);
       xm[i] = x0_[i] - h * u.segment<3>(3 * i);
     }
-    kl_.energy(xp.data(), fp.data(), serial_);
-    kl_.energy(xm.data(), fm.data(), serial_);
+    kl_.energy(xp.data(), fp.data(), serial_, false);
+    kl_.energy(xm.data(), fm.data(), serial_, false);
     for (std::size_t i = 0; i < n_; ++i) kv.segment<3>(3 * i) = (fm[i] - fp[i]) / (2 * h);
   }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <utility>
 
@@ -182,10 +183,10 @@ void KirchhoffLoveShellT<T>::set_plastic_state(const std::vector<T>& state) {
 
 template <class T>
 void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, double& e_total,
-                                        double& e_membrane) const {
+                                        double* e_membrane) const {
   PointKinematics<T> k;
   gather_kinematics(begin_, ctrl_, coef_, q, x, k);
-  eval_kinematics(q, k, grad, e_total, &e_membrane);
+  eval_kinematics(q, k, grad, e_total, e_membrane);
 }
 
 template <class T>
@@ -266,20 +267,20 @@ void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinem
 
 template <class T>
 typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec3T* x,
-                                                                       Vec3T* forces,
-                                                                       bool serial) const {
+                                                                       Vec3T* forces, bool serial,
+                                                                       bool membrane) const {
   const std::size_t nq = area_.size();
   // Per-point adjoints of (a_1, a_2, a_11, a_12, a_22); every entry is written below.
   std::unique_ptr<T[]> grad(forces ? new T[15 * nq] : nullptr);
   // Per chunk: total and membrane energy.
-  const std::vector<std::array<double, 2>> parts =
-      chunk_parts(nq, kPointGrain, serial, std::array<double, 2>{0.0, 0.0},
-                  [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
-                    double et = 0.0, em = 0.0;
-                    for (std::size_t q = b; q < e; ++q)
-                      eval_point(q, x, forces ? &grad[15 * q] : nullptr, et, em);
-                    part = {et, em};
-                  });
+  const std::vector<std::array<double, 2>> parts = chunk_parts(
+      nq, kPointGrain, serial, std::array<double, 2>{0.0, 0.0},
+      [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
+        double et = 0.0, em = 0.0;
+        for (std::size_t q = b; q < e; ++q)
+          eval_point(q, x, forces ? &grad[15 * q] : nullptr, et, membrane ? &em : nullptr);
+        part = {et, em};
+      });
   double et = 0.0, em = 0.0;
   for (const std::array<double, 2>& part : parts) {
     et += part[0];
@@ -307,8 +308,8 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
   }
   Energy out;
   out.total = T(et);
-  out.membrane = T(em);
-  out.bending = T(et - em);
+  out.membrane = membrane ? T(em) : std::numeric_limits<T>::quiet_NaN();
+  out.bending = membrane ? T(et - em) : std::numeric_limits<T>::quiet_NaN();
   return out;
 }
 

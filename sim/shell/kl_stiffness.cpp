@@ -43,7 +43,8 @@ void KirchhoffLoveShellT<T>::stiffness_blocks(
           for (std::size_t q = q0 + b; q < q0 + e; ++q) {
             kl::PointKinematics<double> k0;
             kl::gather_kinematics(begin_, ctrl_, coef_, q, x, k0);
-            const double h = h_rel * std::max(k0.a1.norm(), k0.a2.norm());
+            double h = h_rel * std::max(k0.a1.norm(), k0.a2.norm());
+            if (!(h > 0)) h = h_rel;  // a collapsed point: its energy is not finite anyway
             Mat15& H = hess[q - q0];
             double g0[15], gp[15], et = 0;
             eval_kinematics(q, k0, g0, et, nullptr);

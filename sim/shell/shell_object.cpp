@@ -137,7 +137,8 @@ KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector
                                                bool serial) const {
   const std::size_t n = x.size();
   f.assign(n, Vec3::Zero());
-  const KirchhoffLoveShell::Energy e = kl_->energy(x.data(), f.data(), serial);
+  // The membrane/bending split is a statistic (Solver::measure): not on the hot path.
+  const KirchhoffLoveShell::Energy e = kl_->energy(x.data(), f.data(), serial, false);
   if (mat_.stiffness_damping > 0) {
     // Rayleigh stiffness damping -beta K v, with K v from the directional derivative of
     // the elastic force: f(x + eps v) - f(x) = -eps K v + O(eps^2).
@@ -145,7 +146,7 @@ KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector
     const Real eps = Real(1e-4);
     std::vector<Vec3> xs(n), f2(n, Vec3::Zero());
     for (std::size_t i = 0; i < n; ++i) xs[i] = x[i] + eps * v[i];
-    kl_->energy(xs.data(), f2.data(), serial);
+    kl_->energy(xs.data(), f2.data(), serial, false);
     const Real c = static_cast<Real>(mat_.stiffness_damping) / eps;
     for (std::size_t i = 0; i < n; ++i) f[i] += c * (f2[i] - f[i]);
   }
@@ -222,7 +223,7 @@ StaticSolveResult ShellObject::settle(const Vec3d& gravity, double time, double 
       }
   }
   auto total_force = [&](const std::vector<Vec3d>& p, std::vector<Vec3d>& f) {
-    kl.energy(p.data(), f.data(), serial);
+    kl.energy(p.data(), f.data(), serial, false);
     add_loads(desc_, tris_, mass, gravity, p, f);
   };
   const StaticSolveResult r = solve_static(xd, free_mask, total_force, opt);

@@ -191,6 +191,15 @@ TEST_CASE("KL energy and forces do not depend on the thread count", "[kl]") {
     CHECK(f1[i] == fp[i]);
   }
   CHECK(sh.max_strain(x.data(), true) == sh.max_strain(x.data(), false));
+  // Without the membrane/bending split: the same total and forces, bit for bit, and the
+  // split marked as not computed.
+  std::vector<V3> fn(x.size(), V3::Zero());
+  const auto en = sh.energy(x.data(), fn.data(), false, false);
+  CHECK(en.total == ep.total);
+  CHECK(std::isnan(en.membrane));
+  CHECK(std::isnan(en.bending));
+  CHECK(ep.membrane > 0);
+  for (std::size_t i = 0; i < x.size(); ++i) CHECK(fn[i] == fp[i]);
 }
 
 TEST_CASE("KL patch test: affine deformation gives uniform stress", "[kl]") {
