@@ -8,13 +8,10 @@
 #include "sim/shell/kl_stiffness.h"
 
 namespace shellmpm {
-namespace {}  // namespace
-
-/// The finite-difference stiffness of the last step's preconditioner, for the next steps.
+/// The Kirchhoff-Love stiffness of the last step's preconditioner, for the next steps.
 struct ShellImplicitStep::StiffnessCache {
-  std::shared_ptr<const SparseMatrixD> K;  ///< -df/dx over the free components (numbering below)
+  std::shared_ptr<const SparseMatrixD> K;  ///< d^2E/dx^2 over the free components; null: none
   std::vector<int> dof_of;                 ///< the numbering it was assembled with
-  bool valid = false;
 };
 
 namespace {
@@ -23,19 +20,11 @@ class ShellObjective final : public ImplicitObjective {
  public:
   /// cache: where the stiffness is kept between steps; reuse: the first preconditioner
   /// of this step may take it from there (when the free components are the same).
-  ShellObjective(const KirchhoffLoveShellT<double>& kl,
-                 const std::vector<std::vector<int>>& coupling, const ShellObject& sh,
-                 const Vec3d& gravity, double t, double dt, double theta,
-                 ImplicitPreconditioner pre, bool serial, const std::vector<Collider>* colliders,
+  ShellObjective(const KirchhoffLoveShellT<double>& kl, const ShellObject& sh, const Vec3d& gravity,
+                 double t, double dt, double theta, ImplicitPreconditioner pre, bool serial,
+                 const std::vector<Collider>* colliders,
                  ShellImplicitStep::StiffnessCache* cache = nullptr, bool reuse = false)
-      : kl_(kl),
-        coupling_(coupling),
-        dt_(dt),
-        theta_(theta),
-        pre_(pre),
-        serial_(serial),
-        cache_(cache),
-        reuse_(reuse) {
+      : kl_(kl), dt_(dt), theta_(theta), pre_(pre), serial_(serial), cache_(cache), reuse_(reuse) {
     n_ = sh.size();
     x0_.resize(n_);
     xb_.resize(n_);
@@ -141,18 +130,19 @@ class ShellObjective final : public ImplicitObjective {
         dof_of[k] = dofs++;
       }
     dof_of_ = dof_of;
-    if (reuse_ && cache_ && cache_->valid && cache_->dof_of == dof_of) {
+    if (reuse_ && cache_ && cache_->K && cache_->dof_of == dof_of) {
       reused_ = true;
       K_ = cache_->K;
     } else {
+      // The old stiffness goes first (as the factor above): not two alive at once.
       K_.reset();
+      if (cache_) cache_->K.reset();
       K_ = std::make_shared<const SparseMatrixD>(
           kl_stiffness_matrix(kl_, moved(u), dof_of, dofs, serial_));
       ++assembled_;
       if (cache_) {
         cache_->K = K_;
         cache_->dof_of = dof_of;
-        cache_->valid = true;
       }
     }
     reuse_ = false;  // a refresh within the solve assembles afresh
@@ -257,13 +247,12 @@ class ShellObjective final : public ImplicitObjective {
   }
 
   const KirchhoffLoveShellT<double>& kl_;
-  const std::vector<std::vector<int>>& coupling_;
   double dt_, theta_, damping_ = 0, beta_ = 0, length_ = 1;
   ImplicitPreconditioner pre_;
   bool serial_;
   ShellImplicitStep::StiffnessCache* cache_;
   bool reuse_, reused_ = false;
-  int assembled_ = 0;  ///< finite-difference stiffness assemblies in this solve
+  int assembled_ = 0;  ///< stiffness assemblies in this solve
   std::shared_ptr<const SparseMatrixD> K_;
   std::size_t n_ = 0;
   std::vector<Vec3d> x0_, xb_, fext_, f_, pen_grad_;
@@ -279,15 +268,15 @@ class ShellObjective final : public ImplicitObjective {
 }  // namespace
 
 ShellImplicitStep::ShellImplicitStep(const ShellObject& sh)
-    : kl_(sh.double_kl(&coupling_)), cache_(std::make_unique<StiffnessCache>()) {}
+    : kl_(sh.double_kl()), cache_(std::make_unique<StiffnessCache>()) {}
 ShellImplicitStep::~ShellImplicitStep() = default;
 
 std::unique_ptr<ImplicitObjective> ShellImplicitStep::objective(
     const ShellObject& sh, const Vec3d& gravity, double t, double dt, double theta,
     ImplicitPreconditioner pre, bool serial, VecXd& u0, const std::vector<Collider>* colliders) {
   sh.sync_double_kl(*kl_);
-  auto obj = std::make_unique<ShellObjective>(*kl_, coupling_, sh, gravity, t, dt, theta, pre,
-                                              serial, colliders);
+  auto obj =
+      std::make_unique<ShellObjective>(*kl_, sh, gravity, t, dt, theta, pre, serial, colliders);
   u0 = obj->initial();
   return obj;
 }
@@ -297,13 +286,13 @@ NewtonReport ShellImplicitStep::step(ShellObject& sh, const Vec3d& gravity, doub
                                      ImplicitPreconditioner pre, bool serial,
                                      const std::vector<Collider>* colliders, std::uint64_t epoch) {
   sh.sync_double_kl(*kl_);
-  if (epoch != epoch_) cache_->valid = false;
+  if (epoch != epoch_) cache_->K.reset();
   epoch_ = epoch;
-  bool reuse = cache_->valid && age_ < kMaxStiffnessAge;
+  bool reuse = cache_->K && age_ < kMaxStiffnessAge;
   NewtonReport total;
   for (;;) {
-    ShellObjective obj(*kl_, coupling_, sh, gravity, t, dt, theta, pre, serial, colliders,
-                       cache_.get(), reuse);
+    ShellObjective obj(*kl_, sh, gravity, t, dt, theta, pre, serial, colliders, cache_.get(),
+                       reuse);
     VecXd u = obj.initial();
     NewtonReport rep = newton_minimise(obj, u, opt);
     rep.iterations += total.iterations;
@@ -317,7 +306,7 @@ NewtonReport ShellImplicitStep::step(ShellObject& sh, const Vec3d& gravity, doub
     } else {
       ++age_;
       // A stale stiffness that costs CG iterations (or the solve) is assembled afresh.
-      if (per_newton > 2 * fresh_cg_per_newton_ + 4) cache_->valid = false;
+      if (per_newton > 2 * fresh_cg_per_newton_ + 4) cache_->K.reset();
       if (!rep.converged) {
         reuse = false;
         continue;  // again with the stiffness at this state

@@ -16,11 +16,11 @@
 //
 // The Kirchhoff-Love energy is evaluated in double (ShellObject::double_kl); Hessian
 // products are central differences of the gradient (newton.h). Preconditioner: the
-// tangent M (1 + dt c) + (dt^2 + dt beta) K assembled by finite differences of the forces
-// (fd_stiffness.h) at the start of the step and factorised (`factorised`, CG then takes a
-// few iterations per Newton step), or its 3x3 diagonal blocks (`block_jacobi`, no
-// factorisation; many more CG iterations on stiff sheets). The finite-difference
-// stiffness (most of a short step's cost) is kept for the next steps of the same epoch
+// tangent M (1 + dt theta c) + (dt^2 theta^2 + dt theta beta) K + dt^2 theta^2 K_collider,
+// K from per quadrature point Hessians (kl_stiffness.h), factorised (`factorised`, CG
+// then takes a few iterations per Newton step), or its 3x3 diagonal blocks
+// (`block_jacobi`, no factorisation; many more CG iterations on stiff sheets). The
+// stiffness is kept for the next steps of the same epoch
 // (the solver's advance: a resume starts a new one, so it reproduces the run) and the
 // preconditioner rebuilt from it with the step's dt, mass and collider terms; it is
 // assembled afresh after kMaxStiffnessAge steps, when a step needs more than twice the
@@ -60,7 +60,6 @@ class ShellImplicitStep {
                                                const std::vector<Collider>* colliders = nullptr);
 
  private:
-  std::vector<std::vector<int>> coupling_;  // before kl_: the constructor fills both
   std::unique_ptr<KirchhoffLoveShellT<double>> kl_;
   std::unique_ptr<StiffnessCache> cache_;
   std::uint64_t epoch_ = 0;

@@ -35,6 +35,8 @@ void KirchhoffLoveShellT<T>::stiffness_blocks(
   // in point order.
   constexpr std::size_t kChunk = 2048;
   std::vector<Mat15> hess(std::min(nq, kChunk));
+  std::vector<std::array<double, 5>> c;         // per entry of a point: d(input)/dx
+  std::vector<Eigen::Matrix<double, 15, 3>> M;  // per entry: H J_entry
   for (std::size_t q0 = 0; q0 < nq; q0 += kChunk) {
     const std::size_t q1 = std::min(nq, q0 + kChunk);
     parallel_for(
@@ -64,7 +66,8 @@ void KirchhoffLoveShellT<T>::stiffness_blocks(
       const std::size_t b = begin_[q], n = begin_[q + 1] - b;
       // d(input k)/dx of each entry: its weight, the first entry minus the sum of the
       // others (gather_kinematics sums differences to it).
-      std::vector<std::array<double, 5>> c(n);
+      c.resize(n);
+      M.resize(n);
       std::array<double, 5> first{0, 0, 0, 0, 0};
       for (std::size_t a = 1; a < n; ++a)
         for (int kk = 0; kk < 5; ++kk) {
@@ -73,7 +76,6 @@ void KirchhoffLoveShellT<T>::stiffness_blocks(
         }
       c[0] = first;
       // M_f = H J_f (15 x 3), then K_ef = J_e^T M_f.
-      std::vector<Eigen::Matrix<double, 15, 3>> M(n);
       for (std::size_t f = 0; f < n; ++f) {
         M[f].setZero();
         for (int kk = 0; kk < 5; ++kk)
