@@ -1,13 +1,13 @@
 #!/bin/sh
-# The per-ISA objects of sim/mpm/stress_batch.h must define nothing but their entry
-# points: an inline function emitted there (a weak symbol) could be the copy the linker
+# The per-ISA objects (sim/mpm/stress_batch_avx*.cpp, sim/mpm/transfer_blocks_avx*.cpp)
+# must define nothing but their entry points: an inline function emitted there (a weak symbol) could be the copy the linker
 # keeps for every other translation unit, which would then need AVX2 or AVX-512.
 # Usage: check-isa-symbols.sh OBJECT... (the others are ignored)
 status=0
 found=0
 for obj in "$@"; do
   case "$obj" in
-    *stress_batch_avx*) ;;
+    *stress_batch_avx* | *transfer_blocks_avx*) ;;
     *) continue ;;
   esac
   found=$((found + 1))
@@ -17,7 +17,8 @@ for obj in "$@"; do
     continue
   fi
   extra=$(echo "$syms" | grep -v ' [tTrRbBdD] ' | grep -v '^$' | grep -v ':$')
-  strong=$(echo "$syms" | grep ' T ' | grep -v 'shellmpm::stress_batch::run_avx')
+  strong=$(echo "$syms" | grep ' T ' | grep -v 'shellmpm::stress_batch::run_avx' |
+    grep -v 'shellmpm::transfer_blocks::[pg]2[gp]_avx')
   if [ -n "$extra$strong" ]; then
     echo "$obj defines more than its entry point:"
     echo "$extra"
@@ -25,8 +26,8 @@ for obj in "$@"; do
     status=1
   fi
 done
-if [ "$found" -ne 2 ]; then
-  echo "expected the two stress_batch_avx objects, found $found"
+if [ "$found" -ne 4 ]; then
+  echo "expected the four per-ISA objects, found $found"
   status=1
 fi
 exit $status

@@ -7,12 +7,14 @@
 //
 // The node loops factor the tensor-product sums: with d = node - fx (grid units),
 // A d = (A (-fx)) + A.col(0) i + A.col(1) j + A.col(2) k, and the kernel gradient
-// (dwx wy wz, wx dwy wz, wx wy dwz) splits into per-axis factors, so the innermost loop
-// does a few vector FMAs per node.
+// (dwx wy wz, wx dwy wz, wx wy dwz) splits into per-axis factors. The z axis lives in the
+// lanes of a row vector (sim/mpm/stencil_row.h: the three nodes along z at once), so each
+// of the nine rows costs a few vector operations.
 #pragma once
 #include "sim/core/types.h"
 #include "sim/mpm/bspline.h"
 #include "sim/mpm/sparse_grid.h"
+#include "sim/mpm/stencil_row.h"
 
 namespace shellmpm {
 
@@ -41,39 +43,41 @@ inline void for_each_stencil_node(const QuadraticWeights& W, const Vec3i& block_
 /// w_n (base + A (n - fx)) - S grad w_n (kStress), where `base` already holds
 /// m v - A fx (plus any impulse), A is the affine term in grid units (m dx C, MLS: minus the
 /// stress term) and S the APIC stress term dt V0 tau / dx.
+///
+/// With the z factors in the lanes of a row vector (WZ, DWZ, K = k), node (i, j, k) is
+///   wx wy [WZ (mb + K a2) - DWZ s2] + i wx wy WZ a0 + j wx wy WZ a1 - dwx wy WZ s0
+///   - wx dwy WZ s1,
+/// mb = (m, base), a_c = (0, A.col(c)), s_c = (0, S.col(c)): per row two products and a
+/// difference.
 template <bool kStress>
 inline void apic_scatter(GridNode* buf, const QuadraticWeights& W, const Vec3i& block_corner,
                          Real m, const Vec3& base, const Mat3& A, const Mat3& S) {
   const int lx = W.base[0] - block_corner[0], ly = W.base[1] - block_corner[1],
             lz = W.base[2] - block_corner[2];
+  using namespace stencil_row;
+  const Real ks[3] = {0, 1, 2};
+  const Row wz = per_node(W.w[2]);
+  Row p0 = wz * (splat(m, base) + per_node(ks) * splat(0, A.col(2)));
+  const Row pa0 = wz * splat(0, A.col(0)), pa1 = wz * splat(0, A.col(1));
+  Row ps0 = zero(), ps1 = zero();
+  if constexpr (kStress) {
+    p0 = p0 - per_node(W.dw[2]) * splat(0, S.col(2));
+    ps0 = wz * splat(0, S.col(0));
+    ps1 = wz * splat(0, S.col(1));
+  }
   for (int i = 0; i < 3; ++i) {
-    const Vec3 bi = base + Real(i) * A.col(0);
-    Vec3 s0i, s12i, s2i;
+    Row xi = W.w[0][i] * (p0 + Real(i) * pa0);
+    Row yi = zero();
     if constexpr (kStress) {
-      s0i = W.dw[0][i] * S.col(0);
-      s12i = W.w[0][i] * S.col(1);
-      s2i = W.w[0][i] * S.col(2);
+      xi = xi - W.dw[0][i] * ps0;
+      yi = W.w[0][i] * ps1;
     }
+    const Row ai = W.w[0][i] * pa1;
     for (int j = 0; j < 3; ++j) {
-      const Vec3 bij = bi + Real(j) * A.col(1);
-      const Real wxy = W.w[0][i] * W.w[1][j];
-      // Force factors: S gw = (s0i wy + s12i dwy) wz + (s2i wy) dwz.
-      Vec3 fz, fdz;
-      if constexpr (kStress) {
-        fz = W.w[1][j] * s0i + W.dw[1][j] * s12i;
-        fdz = W.w[1][j] * s2i;
-      }
+      Row add = W.w[1][j] * (xi + Real(j) * ai);
+      if constexpr (kStress) add = add - W.dw[1][j] * yi;
       GridNode* row = &buf[pad_node(lx + i, ly + j, lz)];
-      for (int k = 0; k < 3; ++k) {
-        const Real w = wxy * W.w[2][k];
-        Vec3 mom = w * (bij + Real(k) * A.col(2));
-        if constexpr (kStress) mom -= W.w[2][k] * fz + W.dw[2][k] * fdz;
-        GridNode& nd = row[k];
-        nd.m += w * m;
-        nd.v[0] += mom[0];
-        nd.v[1] += mom[1];
-        nd.v[2] += mom[2];
-      }
+      store(row, load(row) + add);
     }
   }
 }
@@ -87,54 +91,56 @@ struct ApicGather {
   Mat3 grad;  ///< only with kGrad
 };
 
+/// The sums run over rows first (weights of x and y), with the z weights applied to the
+/// lanes at the end.
 template <bool kGrad>
 inline ApicGather apic_gather(const GridNode* buf, const QuadraticWeights& W,
                               const Vec3i& block_corner) {
   const int lx = W.base[0] - block_corner[0], ly = W.base[1] - block_corner[1],
             lz = W.base[2] - block_corner[2];
-  // Sums over nodes of w v, w v i, w v j, w v k and the gradient sums, built per axis.
-  Vec3 v = Vec3::Zero(), vi_sum = Vec3::Zero(), vj_sum = Vec3::Zero(), vk_sum = Vec3::Zero();
-  Vec3 gx = Vec3::Zero(), gy = Vec3::Zero(), gz = Vec3::Zero();
+  using namespace stencil_row;
+  Row v = zero(), vi = zero(), vj = zero(), gx = zero(), gy = zero();
   for (int i = 0; i < 3; ++i) {
-    Vec3 P = Vec3::Zero(), Pj = Vec3::Zero(), Pk = Vec3::Zero(), Gy = Vec3::Zero(),
-         Gz = Vec3::Zero();
+    Row P = zero(), Pj = zero(), Gy = zero();
     for (int j = 0; j < 3; ++j) {
-      const GridNode* row = &buf[pad_node(lx + i, ly + j, lz)];
-      Vec3 Q = Vec3::Zero(), Qk = Vec3::Zero(), Qdz = Vec3::Zero();
-      for (int k = 0; k < 3; ++k) {
-        const Vec3 vn(row[k].v[0], row[k].v[1], row[k].v[2]);
-        const Vec3 wv = W.w[2][k] * vn;
-        Q += wv;
-        Qk += Real(k) * wv;
-        if constexpr (kGrad) Qdz += W.dw[2][k] * vn;
-      }
-      P += W.w[1][j] * Q;
-      Pj += (W.w[1][j] * Real(j)) * Q;
-      Pk += W.w[1][j] * Qk;
-      if constexpr (kGrad) {
-        Gy += W.dw[1][j] * Q;
-        Gz += W.w[1][j] * Qdz;
-      }
+      const Row r = load(&buf[pad_node(lx + i, ly + j, lz)]);
+      P = P + W.w[1][j] * r;
+      Pj = Pj + (W.w[1][j] * Real(j)) * r;
+      if constexpr (kGrad) Gy = Gy + W.dw[1][j] * r;
     }
-    v += W.w[0][i] * P;
-    vi_sum += (W.w[0][i] * Real(i)) * P;
-    vj_sum += W.w[0][i] * Pj;
-    vk_sum += W.w[0][i] * Pk;
+    v = v + W.w[0][i] * P;
+    vi = vi + (W.w[0][i] * Real(i)) * P;
+    vj = vj + W.w[0][i] * Pj;
     if constexpr (kGrad) {
-      gx += W.dw[0][i] * P;
-      gy += W.w[0][i] * Gy;
-      gz += W.w[0][i] * Gz;
+      gx = gx + W.dw[0][i] * P;
+      gy = gy + W.w[0][i] * Gy;
     }
   }
+  const Real ks[3] = {0, 1, 2};
+  const Row wz = per_node(W.w[2]);
+  // Lane 0 of each node sum is the (unused) mass; 1..3 the velocity components.
+  alignas(16) Real sv[4], si[4], sj[4], sk[4];
+  node_sum(wz * v, sv);
+  node_sum(wz * vi, si);
+  node_sum(wz * vj, sj);
+  node_sum((wz * per_node(ks)) * v, sk);
   ApicGather out;
-  out.v = v;
-  out.B.col(0) = vi_sum - W.fx[0] * v;
-  out.B.col(1) = vj_sum - W.fx[1] * v;
-  out.B.col(2) = vk_sum - W.fx[2] * v;
+  for (int c = 0; c < 3; ++c) {
+    out.v[c] = sv[c + 1];
+    out.B(c, 0) = si[c + 1] - W.fx[0] * sv[c + 1];
+    out.B(c, 1) = sj[c + 1] - W.fx[1] * sv[c + 1];
+    out.B(c, 2) = sk[c + 1] - W.fx[2] * sv[c + 1];
+  }
   if constexpr (kGrad) {
-    out.grad.col(0) = gx;
-    out.grad.col(1) = gy;
-    out.grad.col(2) = gz;
+    alignas(16) Real gxs[4], gys[4], gzs[4];
+    node_sum(wz * gx, gxs);
+    node_sum(wz * gy, gys);
+    node_sum(per_node(W.dw[2]) * v, gzs);
+    for (int c = 0; c < 3; ++c) {
+      out.grad(c, 0) = gxs[c + 1];
+      out.grad(c, 1) = gys[c + 1];
+      out.grad(c, 2) = gzs[c + 1];
+    }
   }
   return out;
 }

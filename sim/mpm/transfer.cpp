@@ -5,22 +5,16 @@
 #include <type_traits>
 
 #include "sim/core/parallel.h"
-#include "sim/mpm/apic_stencil.h"
+#include "sim/mpm/stress_batch.h"
+#include "sim/mpm/transfer_blocks.h"
 
 namespace shellmpm {
 namespace {
 
+using transfer_blocks::bulk_begin;
+
 // Kirchhoff stresses of one particle block, in block order, computed in SIMD batches
 // over runs of particles that share a material.
-// First position in block b's slice of grid.order that holds a bulk particle (indices
-// ascend within a block, other points come first).
-std::uint32_t bulk_begin(const SparseGrid& grid, const TransferParams& tp, std::size_t b) {
-  const std::uint32_t s0 = grid.pblock_start[b], s1 = grid.pblock_start[b + 1];
-  if (tp.first_bulk == 0) return s0;
-  const auto* o = grid.order.data();
-  return static_cast<std::uint32_t>(std::lower_bound(o + s0, o + s1, tp.first_bulk) - o);
-}
-
 void block_stresses(const ParticleSet& p, const SparseGrid& grid, const TransferParams& tp,
                     std::size_t b, std::vector<Mat3>& F, std::vector<Real>& pl,
                     std::vector<Mat3>& tau) {
@@ -56,51 +50,24 @@ void p2g_block(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp,
   thread_local std::vector<Mat3> F_local, tau_local;
   thread_local std::vector<Real> pl_local;
   block_stresses(p, grid, tp, b, F_local, pl_local, tau_local);
-  auto& buf = grid.pblock_buf[b];
-  std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
-  const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
-  const Real dx = static_cast<Real>(grid.dx());
-  const Real dt = tp.dt;
-  const auto& rho = *tp.densities;
-  const std::uint32_t s0 = bulk_begin(grid, tp, b);
-  for (std::uint32_t s = s0; s < grid.pblock_start[b + 1]; ++s) {
-    const std::uint32_t q = grid.order[s] - tp.first_bulk;
-    const QuadraticWeights W(grid.grid_coord(p.x[q]));
-    const Real vol = p.volume[q];
-    const Real m = vol * rho[p.material[q]];
-    const Mat3& tau = tau_local[s - s0];
-    // Affine term in grid units: world dpos = dx * (node - fx).
-    Mat3 A = (m * dx) * p.C[q];
-    Mat3 S = Mat3::Zero();
-    if (kMls)
-      A -= (Real(4) * dt * vol / dx) * tau;  // MLS: -dt V0 M^-1 tau, M^-1 = 4/dx^2
-    else
-      S = (dt * vol / dx) * tau;  // APIC: -dt V0 tau grad w, grad w = dw_grid / dx
-    const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-    apic_scatter<!kMls>(buf.data(), W, bc, m, m * p.v[q] - A * fx, A, S);
-  }
+  const SimdLevel level = simd_level();
+  if (level == SimdLevel::Avx512)
+    transfer_blocks::p2g_avx512(kMls, p, grid, tp, b, tau_local.data());
+  else if (level == SimdLevel::Avx2)
+    transfer_blocks::p2g_avx2(kMls, p, grid, tp, b, tau_local.data());
+  else
+    transfer_blocks::p2g<kMls>(p, grid, tp, b, tau_local.data());
 }
 
 template <bool kMls>
 void g2p_block(ParticleSet& p, SparseGrid& grid, const TransferParams& tp, std::size_t b) {
-  const auto& buf = grid.pblock_buf[b];
-  const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
-  const Real dx = static_cast<Real>(grid.dx());
-  const Real inv_dx = Real(1) / dx;
-  const Real dt = tp.dt;
-  for (std::uint32_t s = bulk_begin(grid, tp, b); s < grid.pblock_start[b + 1]; ++s) {
-    const std::uint32_t q = grid.order[s] - tp.first_bulk;
-    const QuadraticWeights W(grid.grid_coord(p.x[q]));
-    const ApicGather G = apic_gather<!kMls>(buf.data(), W, bc);
-    // C = B D^-1 with D = dx^2/4 I, B_world = dx B.
-    const Mat3 C = (Real(4) * inv_dx) * G.B;
-    const Mat3 gradv = kMls ? C : Mat3(inv_dx * G.grad);
-    const Vec3& v = G.v;
-    p.v[q] = v;
-    p.C[q] = C;
-    p.x[q] += dt * v;
-    p.F[q] = (Mat3::Identity() + dt * gradv) * p.F[q];
-  }
+  const SimdLevel level = simd_level();
+  if (level == SimdLevel::Avx512)
+    transfer_blocks::g2p_avx512(kMls, p, grid, tp, b);
+  else if (level == SimdLevel::Avx2)
+    transfer_blocks::g2p_avx2(kMls, p, grid, tp, b);
+  else
+    transfer_blocks::g2p<kMls>(p, grid, tp, b);
 }
 
 /// For every particle block b in parallel: block(b, kMls) with the scheme's flag (APIC or
