@@ -1,5 +1,5 @@
-// The one stable counting sort (bucket offsets plus the items in bucket order) that binning
-// and gather maps use: particles by grid block (sim/mpm/sparse_grid.cpp), basis entries by
+// The one stable counting sort (bucket offsets plus the items in bucket order) that the
+// gather maps use (particle binning sorts runs instead, sim/mpm/sparse_grid.cpp): basis entries by
 // control point (sim/shell/kirchhoff_love.cpp), faces by vertex (sim/shell/loop_basis.cpp).
 #pragma once
 #include <cstddef>

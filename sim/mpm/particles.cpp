@@ -9,24 +9,49 @@
 namespace shellmpm {
 namespace {
 
+// a[i] = a[order[i]] for every i, one word (4 or 2 bytes) of the element at a time, so the
+// scratch is one word per particle, not one element (36 B for a Mat3): the reorder's
+// transient memory stays at 4 B per particle.
+template <class Word, class T>
+void permute_words(std::vector<T>& a, const std::vector<std::uint32_t>& order,
+                   std::vector<std::uint32_t>& scratch) {
+  static_assert(sizeof(T) % sizeof(Word) == 0 && sizeof(Word) <= sizeof(std::uint32_t));
+  constexpr std::size_t kWords = sizeof(T) / sizeof(Word);
+  const std::size_t n = a.size();
+  scratch.resize(n);
+  auto* bytes = reinterpret_cast<unsigned char*>(a.data());
+  for (std::size_t w = 0; w < kWords; ++w) {
+    parallel_for(n, 8192, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        Word x;
+        std::memcpy(&x, bytes + order[i] * sizeof(T) + w * sizeof(Word), sizeof(Word));
+        scratch[i] = x;
+      }
+    });
+    parallel_for(n, 8192, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Word x = static_cast<Word>(scratch[i]);
+        std::memcpy(bytes + i * sizeof(T) + w * sizeof(Word), &x, sizeof(Word));
+      }
+    });
+  }
+}
+
 template <class T>
 void permute_one(std::vector<T>& a, const std::vector<std::uint32_t>& order,
-                 std::vector<unsigned char>& scratch) {
+                 std::vector<std::uint32_t>& scratch) {
   if (a.empty()) return;
-  const std::size_t n = a.size();
-  scratch.resize(n * sizeof(T));
-  T* out = reinterpret_cast<T*>(scratch.data());
-  parallel_for(n, 8192, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) out[i] = a[order[i]];
-  });
-  std::memcpy(static_cast<void*>(a.data()), out, n * sizeof(T));
+  if constexpr (sizeof(T) % 4 == 0)
+    permute_words<std::uint32_t>(a, order, scratch);
+  else
+    permute_words<std::uint16_t>(a, order, scratch);
 }
 
 }  // namespace
 
 void ParticleSet::permute(const std::vector<std::uint32_t>& order) {
   SHELLMPM_CHECK(order.size() == size(), << order.size() << " vs " << size());
-  std::vector<unsigned char> scratch;
+  std::vector<std::uint32_t> scratch;
   permute_one(x, order, scratch);
   permute_one(v, order, scratch);
   permute_one(C, order, scratch);

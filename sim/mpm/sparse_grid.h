@@ -120,7 +120,15 @@ class SparseGrid {
   double dx_ = 1.0, inv_dx_ = 1.0;
   Vec3d origin_{0, 0, 0};
   BlockHash phash_, ghash_;
-  std::vector<std::uint32_t> pblock_of_;  ///< per particle: its particle block
+  /// A run of consecutive points in one particle block: its key, first point, and its
+  /// block index (then its first slot in order).
+  struct Run {
+    std::uint64_t key;
+    std::uint32_t begin, block;
+  };
+  static constexpr std::size_t kBinChunk = 16384;  ///< points per binning chunk
+  std::vector<std::vector<Run>> chunk_runs_;      ///< per chunk, kept between calls
+  std::size_t runs_bytes() const;
 };
 
 }  // namespace shellmpm

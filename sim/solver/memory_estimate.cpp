@@ -370,9 +370,9 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   // A step: the adjoints of the largest shell's forces; an emitting run also copies one
   // particle attribute (a Mat3) when its arrays double.
   const double growth = n.emitted_particles > 0 ? kMat3 * n.peak_particles() : 0;
-  // After each frame the particles are sorted by block, through one scratch array that
-  // grows from a Vec3 to a Mat3 per particle (both alive at the resize).
-  const double permute = (kVec3 + kMat3) * n.peak_particles();
+  // After each frame the particles are sorted by block, one 4-byte word of every attribute
+  // at a time through a scratch word per particle (sim/mpm/particles.cpp).
+  const double permute = 4.0 * n.peak_particles();
   // Contact and integrity scratch of a step (measured: about 200 bytes per contact site).
   const double contact_scratch = 200 * n.contact_sites;
   // The implicit grid solve (sim/implicit/grid_step.cpp): about 17 double vectors of 3 per
