@@ -35,9 +35,9 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
           const int bx = static_cast<int>(std::floor(g[0] - Real(0.5))) >> 2;
           const int by = static_cast<int>(std::floor(g[1] - Real(0.5))) >> 2;
           const int bz = static_cast<int>(std::floor(g[2] - Real(0.5))) >> 2;
-          SHELLMPM_CHECK(bx >= 0 && by >= 0 && bz >= 0 && bx < (1 << 19) && by < (1 << 19) &&
-                             bz < (1 << 19),
-                         << "particle " << p << " at " << pos(p).transpose() << " is off the grid");
+          SHELLMPM_CHECK(
+              bx >= 0 && by >= 0 && bz >= 0 && bx < (1 << 19) && by < (1 << 19) && bz < (1 << 19),
+              << "particle " << p << " at " << pos(p).transpose() << " is off the grid");
           const std::uint64_t key = pack_block(bx, by, bz);
           if (runs.empty() || runs.back().key != key)
             runs.push_back({key, static_cast<std::uint32_t>(p), 0});

@@ -127,7 +127,7 @@ class SparseGrid {
     std::uint32_t begin, block;
   };
   static constexpr std::size_t kBinChunk = 16384;  ///< points per binning chunk
-  std::vector<std::vector<Run>> chunk_runs_;      ///< per chunk, kept between calls
+  std::vector<std::vector<Run>> chunk_runs_;       ///< per chunk, kept between calls
   std::size_t runs_bytes() const;
 };
 
