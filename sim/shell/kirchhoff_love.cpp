@@ -115,7 +115,6 @@ void KirchhoffLoveShellT<T>::size_entries(const std::vector<BasisPoint>& points)
   ctrl_.resize(ne);
   coef_.resize(5 * ne);
   value_.resize(ne);
-  entry_q_.resize(ne);
   area_.resize(nq);
   B_.resize(4 * nq * num_layers_);
   B0_.resize(4 * nq);
@@ -133,7 +132,6 @@ PointKinematics<double> KirchhoffLoveShellT<T>::load_point(
                                                              << j << " of quadrature point " << q
                                                              << " out of range " << num_ctrl_);
     ctrl_[e] = j;
-    entry_q_[e] = int(q);
     value_[e] = T(p.N[i]);
     coef_[5 * e + 0] = T(p.N1[i]);
     coef_[5 * e + 1] = T(p.N2[i]);
@@ -160,8 +158,12 @@ PointKinematics<double> KirchhoffLoveShellT<T>::load_point(
 template <class T>
 void KirchhoffLoveShellT<T>::build_gather_map() {
   // Entries by control point (ascending entry order).
+  SHELLMPM_CHECK(ctrl_.size() < (std::size_t(1) << 32), "too many basis entries: " << ctrl_.size());
+  std::vector<std::size_t> order;
   counting_sort(
-      ctrl_.size(), num_ctrl_, [&](std::size_t e) { return ctrl_[e]; }, gather_begin_, gather_);
+      ctrl_.size(), num_ctrl_, [&](std::size_t e) { return ctrl_[e]; }, gather_begin_, order);
+  slot_.resize(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) slot_[order[i]] = static_cast<std::uint32_t>(i);
 }
 
 template <class T>
@@ -190,6 +192,51 @@ void KirchhoffLoveShellT<T>::eval_point(std::size_t q, const Vec3T* x, T* grad, 
 }
 
 template <class T>
+void KirchhoffLoveShellT<T>::eval_points(std::size_t q0, std::size_t n, const Vec3T* x, T* fe,
+                                         double& e_total, double* e_membrane) const {
+  T grad[15];
+  for (std::size_t q = q0; q < q0 + n; ++q) {
+    eval_point(q, x, fe ? grad : nullptr, e_total, e_membrane);
+    if (fe) entry_shares(q, grad, fe);
+  }
+}
+
+template <class T>
+void KirchhoffLoveShellT<T>::entry_shares(std::size_t q, const T* G, T* fe) const {
+  // dE/dx_j from entry (q, j): N1 Ga1 + N2 Ga2 + N11 G11 + N12 G12 + N22 G22.
+  for (std::size_t e = begin_[q]; e < begin_[q + 1]; ++e) {
+    const T* c = &coef_[5 * e];
+    T* out = &fe[3 * std::size_t(slot_[e])];
+    for (int d = 0; d < 3; ++d)
+      out[d] = c[0] * G[d] + c[1] * G[3 + d] + c[2] * G[6 + d] + c[3] * G[9 + d] + c[4] * G[12 + d];
+  }
+}
+
+template <class T>
+double KirchhoffLoveShellT<T>::membrane_energy(std::size_t q, const Vec3T& a1,
+                                               const Vec3T& a2) const {
+  // Mid-surface layer (xi3 = 0), whole thickness, with the layers' Gauss-weighted mean
+  // plastic part.
+  const T* B0 = &B0_[4 * q];
+  T Bp0[4];
+  if (!fp_inv_.empty()) {
+    T fp_mean[4] = {0, 0, 0, 0};
+    T wsum = 0;
+    for (int l = 0; l < num_layers_; ++l) {
+      const T* Fi = &fp_inv_[4 * (q * num_layers_ + l)];
+      for (int i = 0; i < 4; ++i) fp_mean[i] += layer_w_[l] * Fi[i];
+      wsum += layer_w_[l];
+    }
+    for (int i = 0; i < 4; ++i) fp_mean[i] /= wsum;
+    mul2(B0, fp_mean, Bp0);
+    B0 = Bp0;
+  }
+  return double(area_[q] * thickness_ *
+                layer_psi(mu_, lambda_, stiffening_, B0, a1.dot(a1), a1.dot(a2), a2.dot(a2),
+                          static_cast<T*>(nullptr)));
+}
+
+template <class T>
 void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinematics<T>& k,
                                              T* grad, double& e_total, double* e_membrane) const {
   using V3 = Vec3T;
@@ -198,8 +245,6 @@ void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinem
   const T area = area_[q];
   V3 Ga1 = V3::Zero(), Ga2 = V3::Zero(), Gv1 = V3::Zero(), Gv2 = V3::Zero();
   T energy = 0;
-  T fp_mean[4] = {0, 0, 0, 0};
-  T wsum = 0;
   for (int l = 0; l < num_layers_; ++l) {
     const std::size_t ql = q * num_layers_ + l;
     const T xi3 = layer_xi3_[l];
@@ -210,8 +255,6 @@ void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinem
     if (plastic) {
       const T* Fi = &fp_inv_[4 * ql];
       mul2(B, Fi, Bp);
-      for (int i = 0; i < 4; ++i) fp_mean[i] += layer_w_[l] * Fi[i];
-      wsum += layer_w_[l];
       B = Bp;
     }
     const T V = area * layer_w_[l];
@@ -228,18 +271,7 @@ void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinem
     }
   }
   e_total += double(energy);
-  if (e_membrane) {  // membrane diagnostic: mid-surface layer (xi3 = 0), whole thickness
-    const T* B0 = &B0_[4 * q];
-    T Bp0[4];
-    if (plastic) {
-      for (int i = 0; i < 4; ++i) fp_mean[i] /= wsum;
-      mul2(B0, fp_mean, Bp0);
-      B0 = Bp0;
-    }
-    *e_membrane += double(area * thickness_ *
-                          layer_psi(mu_, lambda_, stiffening_, B0, k.a1.dot(k.a1), k.a1.dot(k.a2),
-                                    k.a2.dot(k.a2), static_cast<T*>(nullptr)));
-  }
+  if (e_membrane) *e_membrane += membrane_energy(q, k.a1, k.a2);
   if (!grad) return;
 
   // Backpropagate through v_a = (I - a3 a3^T) m_a / l, l = |n|, n = a1 x a2 (sec. 1):
@@ -270,15 +302,22 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
                                                                        Vec3T* forces, bool serial,
                                                                        bool membrane) const {
   const std::size_t nq = area_.size();
-  // Per-point adjoints of (a_1, a_2, a_11, a_12, a_22); every entry is written below.
-  std::unique_ptr<T[]> grad(forces ? new T[15 * nq] : nullptr);
+  // Each basis entry's share of its control point's force, in gather order (eval_points
+  // writes every one). Kept per calling thread between calls: a fresh array each call
+  // (36 MB on a 100k-point sheet) cost its page faults every time.
+  thread_local std::vector<T> entry_scratch;
+  const std::size_t ne = slot_.size();
+  if (forces && entry_scratch.size() < 3 * ne) {
+    std::vector<T>().swap(entry_scratch);
+    entry_scratch.resize(3 * ne);
+  }
+  T* const fe = forces ? entry_scratch.data() : nullptr;
   // Per chunk: total and membrane energy.
   const std::vector<std::array<double, 2>> parts = chunk_parts(
       nq, kPointGrain, serial, std::array<double, 2>{0.0, 0.0},
       [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
         double et = 0.0, em = 0.0;
-        for (std::size_t q = b; q < e; ++q)
-          eval_point(q, x, forces ? &grad[15 * q] : nullptr, et, membrane ? &em : nullptr);
+        eval_points(b, e - b, x, fe, et, membrane ? &em : nullptr);
         part = {et, em};
       });
   double et = 0.0, em = 0.0;
@@ -287,20 +326,15 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
     em += part[1];
   }
   if (forces) {
-    // Gather: dE/dx_j = sum over entries (q, j) of N1 Ga1 + N2 Ga2 + N11 G11 + N12 G12 + N22 G22.
+    // Gather: dE/dx_j = the sum of its entries' shares, contiguous in gather order
+    // (ascending entry order).
     parallel_for(
         num_ctrl_, kGatherGrain,
         [&](std::size_t b, std::size_t e) {
           for (std::size_t j = b; j < e; ++j) {
             Vec3T f = Vec3T::Zero();
-            for (std::size_t i = gather_begin_[j]; i < gather_begin_[j + 1]; ++i) {
-              const std::size_t en = gather_[i];
-              const T* c = &coef_[5 * en];
-              const T* G = &grad[15 * std::size_t(entry_q_[en])];
-              for (int d = 0; d < 3; ++d)
-                f[d] += c[0] * G[d] + c[1] * G[3 + d] + c[2] * G[6 + d] + c[3] * G[9 + d] +
-                        c[4] * G[12 + d];
-            }
+            for (std::size_t i = gather_begin_[j]; i < gather_begin_[j + 1]; ++i)
+              for (int d = 0; d < 3; ++d) f[d] += fe[3 * i + d];
             forces[j] -= f;
           }
         },

@@ -62,6 +62,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -188,6 +189,18 @@ class KirchhoffLoveShellT {
   void eval_kinematics(std::size_t q, const kl::PointKinematics<T>& k, T* grad, double& e_total,
                        double* e_membrane) const;
 
+  /// eval_point for points q0 .. q0 + n - 1 in order (energies added in that order), each
+  /// point's adjoints turned into its entries' force shares (entry_shares) when fe is not
+  /// null. The float specialisation (sim/shell/kl_batch.cpp) runs four points per SSE
+  /// register.
+  void eval_points(std::size_t q0, std::size_t n, const Vec3T* x, T* fe, double& e_total,
+                   double* e_membrane) const;
+  /// From point q's adjoints G (15 values), writes each of its entries' dE/dx share (3
+  /// values) at the entry's slot in gather order: fe[3 slot_[e] ..].
+  void entry_shares(std::size_t q, const T* G, T* fe) const;
+  /// The membrane diagnostic of point q: its mid-surface layer energy [J] (file comment).
+  double membrane_energy(std::size_t q, const Vec3T& a1, const Vec3T& a2) const;
+
   /// The large-stretch term: s_l, log s_l and k.
   struct Stiffening {
     T limit = 0, log_limit = 0, k = 0;
@@ -207,12 +220,17 @@ class KirchhoffLoveShellT {
   std::vector<T> B_;                    // 4 per (q, layer), row-major B
   std::vector<T> B0_;                   // 4 per q: mid-surface B
   std::vector<T> fp_inv_;               // 4 per (q, layer) (empty without plasticity)
-  // Gather map for forces: entries touching control point j are
-  // gather_[gather_begin_[j] .. gather_begin_[j+1]) in ascending entry order.
+  // Gather map for forces: the entries touching control point j hold the slots
+  // gather_begin_[j] .. gather_begin_[j+1] - 1, in ascending entry order; slot_[e] is
+  // entry e's.
   std::vector<std::size_t> gather_begin_;
-  std::vector<std::size_t> gather_;
-  std::vector<int> entry_q_;  // quadrature point of each entry
+  std::vector<std::uint32_t> slot_;
 };
+
+/// The four-lane float kernel (sim/shell/kl_batch.cpp).
+template <>
+void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, const Vec3T* x, float* fe,
+                                             double& e_total, double* e_membrane) const;
 
 using KirchhoffLoveShell = KirchhoffLoveShellT<Real>;
 

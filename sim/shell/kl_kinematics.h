@@ -33,29 +33,35 @@ inline void compute_kinematics(PointKinematics<T>& k) {
 }
 
 /// a_alpha and a_alphabeta at quadrature point q (entries [begin[q], begin[q+1]) with 5
-/// weights each), then the rest of the kinematics. The derivative weights of a point sum
+/// weights each): out = (a_1, a_2, a_11, a_12, a_22). The derivative weights of a point sum
 /// to zero (partition of unity), so the sums run over differences to the point's first
 /// control point: in float this keeps a_alpha and the small a_alphabeta accurate far
 /// from the origin.
 template <class T>
-void gather_kinematics(const std::vector<std::size_t>& begin, const std::vector<int>& ctrl,
-                       const std::vector<T>& coef, std::size_t q, const Eigen::Matrix<T, 3, 1>* x,
-                       PointKinematics<T>& k) {
-  k.a1.setZero();
-  k.a2.setZero();
-  k.a11.setZero();
-  k.a12.setZero();
-  k.a22.setZero();
+inline void gather_derivatives(const std::vector<std::size_t>& begin, const std::vector<int>& ctrl,
+                               const std::vector<T>& coef, std::size_t q,
+                               const Eigen::Matrix<T, 3, 1>* x, Eigen::Matrix<T, 3, 1> (&out)[5]) {
+  for (auto& a : out) a.setZero();
   const Eigen::Matrix<T, 3, 1>& x0 = x[ctrl[begin[q]]];
   for (std::size_t e = begin[q] + 1; e < begin[q + 1]; ++e) {
     const Eigen::Matrix<T, 3, 1> dx = x[ctrl[e]] - x0;
     const T* c = &coef[5 * e];
-    k.a1 += c[0] * dx;
-    k.a2 += c[1] * dx;
-    k.a11 += c[2] * dx;
-    k.a12 += c[3] * dx;
-    k.a22 += c[4] * dx;
+    for (int i = 0; i < 5; ++i) out[i] += c[i] * dx;
   }
+}
+
+/// gather_derivatives, then the rest of the kinematics.
+template <class T>
+void gather_kinematics(const std::vector<std::size_t>& begin, const std::vector<int>& ctrl,
+                       const std::vector<T>& coef, std::size_t q, const Eigen::Matrix<T, 3, 1>* x,
+                       PointKinematics<T>& k) {
+  Eigen::Matrix<T, 3, 1> a[5];
+  gather_derivatives(begin, ctrl, coef, q, x, a);
+  k.a1 = a[0];
+  k.a2 = a[1];
+  k.a11 = a[2];
+  k.a12 = a[3];
+  k.a22 = a[4];
   compute_kinematics(k);
 }
 
