@@ -206,9 +206,10 @@ void KirchhoffLoveShellT<T>::entry_shares(std::size_t q, const T* G, T* fe) cons
   // dE/dx_j from entry (q, j): N1 Ga1 + N2 Ga2 + N11 G11 + N12 G12 + N22 G22.
   for (std::size_t e = begin_[q]; e < begin_[q + 1]; ++e) {
     const T* c = &coef_[5 * e];
-    T* out = &fe[3 * std::size_t(slot_[e])];
+    T* out = &fe[4 * std::size_t(slot_[e])];
     for (int d = 0; d < 3; ++d)
       out[d] = c[0] * G[d] + c[1] * G[3 + d] + c[2] * G[6 + d] + c[3] * G[9 + d] + c[4] * G[12 + d];
+    out[3] = T(0);
   }
 }
 
@@ -307,9 +308,9 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
   // (36 MB on a 100k-point sheet) cost its page faults every time.
   thread_local std::vector<T> entry_scratch;
   const std::size_t ne = slot_.size();
-  if (forces && entry_scratch.size() < 3 * ne) {
+  if (forces && entry_scratch.size() < 4 * ne) {
     std::vector<T>().swap(entry_scratch);
-    entry_scratch.resize(3 * ne);
+    entry_scratch.resize(4 * ne);
   }
   T* const fe = forces ? entry_scratch.data() : nullptr;
   // Per chunk: total and membrane energy.
@@ -334,7 +335,7 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
           for (std::size_t j = b; j < e; ++j) {
             Vec3T f = Vec3T::Zero();
             for (std::size_t i = gather_begin_[j]; i < gather_begin_[j + 1]; ++i)
-              for (int d = 0; d < 3; ++d) f[d] += fe[3 * i + d];
+              for (int d = 0; d < 3; ++d) f[d] += fe[4 * i + d];
             forces[j] -= f;
           }
         },

@@ -196,7 +196,8 @@ class KirchhoffLoveShellT {
   void eval_points(std::size_t q0, std::size_t n, const Vec3T* x, T* fe, double& e_total,
                    double* e_membrane) const;
   /// From point q's adjoints G (15 values), writes each of its entries' dE/dx share (3
-  /// values) at the entry's slot in gather order: fe[3 slot_[e] ..].
+  /// values and a zero, so that one SSE store writes a share) at the entry's slot in gather
+  /// order: fe[4 slot_[e] ..].
   void entry_shares(std::size_t q, const T* G, T* fe) const;
   /// The membrane diagnostic of point q: its mid-surface layer energy [J] (file comment).
   double membrane_energy(std::size_t q, const Vec3T& a1, const Vec3T& a2) const;

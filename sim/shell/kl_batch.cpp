@@ -181,15 +181,26 @@ void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, cons
     const V3 G12 = cross(cm1, a1) + cross(a2, cm2);
     const V3 G22 = cross(cm2, a1);
     const V3* out[5] = {&Ga1, &Ga2, &G11, &G12, &G22};
-    for (int j = 0; j < cnt; ++j) {
-      float g[15];
-      for (int i = 0; i < 5; ++i) {
-        g[3 * i] = out[i]->x[j];
-        g[3 * i + 1] = out[i]->y[j];
-        g[3 * i + 2] = out[i]->z[j];
-      }
-      entry_shares(qs[j], g, fe);
+    // Per point j the five adjoints as (x, y, z, 0) (a 4x4 transpose each), then each
+    // entry's share c0 Ga1 + c1 Ga2 + c2 G11 + c3 G12 + c4 G22 as in entry_shares, one
+    // SSE store per entry.
+    F4 G[5][4];
+    for (int i = 0; i < 5; ++i) {
+      __m128 r0 = reinterpret_cast<__m128>(out[i]->x), r1 = reinterpret_cast<__m128>(out[i]->y),
+             r2 = reinterpret_cast<__m128>(out[i]->z), r3 = _mm_setzero_ps();
+      _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+      G[i][0] = reinterpret_cast<F4>(r0);
+      G[i][1] = reinterpret_cast<F4>(r1);
+      G[i][2] = reinterpret_cast<F4>(r2);
+      G[i][3] = reinterpret_cast<F4>(r3);
     }
+    for (int j = 0; j < cnt; ++j)
+      for (std::size_t e = begin_[qs[j]]; e < begin_[qs[j] + 1]; ++e) {
+        const float* c = &coef_[5 * e];
+        const F4 share = splat(c[0]) * G[0][j] + splat(c[1]) * G[1][j] + splat(c[2]) * G[2][j] +
+                         splat(c[3]) * G[3][j] + splat(c[4]) * G[4][j];
+        _mm_storeu_ps(&fe[4 * std::size_t(slot_[e])], reinterpret_cast<__m128>(share));
+      }
   }
 }
 
