@@ -1,8 +1,9 @@
 // The Kirchhoff-Love energy and adjoints of four quadrature points at once, in float: the
 // same computation as KirchhoffLoveShellT::eval_kinematics (kirchhoff_love.cpp,
 // laminate_energy.h) with each point in one lane of an SSE register (sim/shell/kl_lanes.h).
-// The per-point gathers of a_alpha and a_alphabeta stay scalar (a point's control points
-// vary); from there on every operation is element-wise, so a point's result does not
+// The per-point gathers of a_alpha and a_alphabeta run one point at a time (a point's
+// control points vary), x, y and z in the lanes; from there on every operation is
+// element-wise, so a point's result does not
 // depend on its lane or its neighbours, and is the same for any thread count. The branches
 // of the scalar code (the small-x series of atanh(x)/x, the stretch term past the limit)
 // are taken in every lane and selected.
@@ -25,6 +26,12 @@ using kl::lanes::splat;
 using kl::lanes::V3;
 
 namespace {
+
+/// (p[0], p[1], p[2], 0) without reading past p[2].
+[[gnu::always_inline]] inline F4 load3(const float* p) {
+  const __m128 xy = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)));
+  return reinterpret_cast<F4>(_mm_movelh_ps(xy, _mm_load_ss(p + 2)));
+}
 
 /// layer_psi (laminate_energy.h) in lanes: psi, and dpsi/dM in S.
 template <class Stiffening>
@@ -106,17 +113,31 @@ void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, cons
     // Lane j: point b + j; lanes past the end repeat the last point (results unused).
     std::size_t qs[4];
     for (int j = 0; j < 4; ++j) qs[j] = b + static_cast<std::size_t>(std::min(j, cnt - 1));
-    Vec3T a[4][5];
-    for (int j = 0; j < cnt; ++j)
-      kl::gather_derivatives(begin_, ctrl_, coef_, qs[j], x, a[j]);
-    for (int j = cnt; j < 4; ++j)
-      for (int i = 0; i < 5; ++i) a[j][i] = a[cnt - 1][i];
-    auto lanes3 = [&](int i) {
-      return V3{F4{a[0][i][0], a[1][i][0], a[2][i][0], a[3][i][0]},
-                F4{a[0][i][1], a[1][i][1], a[2][i][1], a[3][i][1]},
-                F4{a[0][i][2], a[1][i][2], a[2][i][2], a[3][i][2]}};
-    };
-    const V3 a1 = lanes3(0), a2 = lanes3(1), a11 = lanes3(2), a12 = lanes3(3), a22 = lanes3(4);
+    // a_alpha, a_alphabeta of each point (gather_derivatives, one SSE lane per axis), then
+    // transposed to one point per lane.
+    F4 acc[5][4];
+    for (int j = 0; j < 4; ++j) {
+      const std::size_t q = qs[j];
+      if (j >= cnt) {
+        for (int i = 0; i < 5; ++i) acc[i][j] = acc[i][cnt - 1];
+        continue;
+      }
+      for (int i = 0; i < 5; ++i) acc[i][j] = splat(0.0f);
+      const F4 x0 = load3(x[ctrl_[begin_[q]]].data());
+      for (std::size_t e = begin_[q] + 1; e < begin_[q + 1]; ++e) {
+        const F4 dx = load3(x[ctrl_[e]].data()) - x0;
+        const float* c = &coef_[5 * e];
+        for (int i = 0; i < 5; ++i) acc[i][j] = acc[i][j] + splat(c[i]) * dx;
+      }
+    }
+    V3 av[5];
+    for (int i = 0; i < 5; ++i) {
+      __m128 r0 = reinterpret_cast<__m128>(acc[i][0]), r1 = reinterpret_cast<__m128>(acc[i][1]),
+             r2 = reinterpret_cast<__m128>(acc[i][2]), r3 = reinterpret_cast<__m128>(acc[i][3]);
+      _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+      av[i] = V3{reinterpret_cast<F4>(r0), reinterpret_cast<F4>(r1), reinterpret_cast<F4>(r2)};
+    }
+    const V3 a1 = av[0], a2 = av[1], a11 = av[2], a12 = av[3], a22 = av[4];
     // Kinematics (kl_kinematics.h, compute_kinematics).
     const V3 nrm = cross(a1, a2);
     const F4 inv_l = splat(1.0f) / sqrt4(dot(nrm, nrm));
@@ -166,7 +187,9 @@ void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, cons
     }
     for (int j = 0; j < cnt; ++j) {
       e_total += double(energy[j]);
-      if (e_membrane) *e_membrane += membrane_energy(qs[j], a[j][0], a[j][1]);
+      if (e_membrane)
+        *e_membrane += membrane_energy(qs[j], Vec3T(a1.x[j], a1.y[j], a1.z[j]),
+                                       Vec3T(a2.x[j], a2.y[j], a2.z[j]));
     }
     if (!fe) continue;
     // Backpropagation through v_a = (I - a3 a3^T) m_a / l (eval_kinematics).
