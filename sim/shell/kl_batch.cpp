@@ -12,6 +12,7 @@
 // log((1 + x) / (1 - x)) / 2, and past the stretch limit the principal stretches come from
 // the eigenvalues of C (s_1^2 = tr/2 + h, s_2^2 = det / s_1^2) instead of exp(L +- D)/4.
 #include <algorithm>
+#include <cstdint>
 
 #include "sim/shell/kirchhoff_love.h"
 #include "sim/shell/kl_kinematics.h"
@@ -108,6 +109,12 @@ void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, cons
                                              double* e_membrane) const {
   using namespace kl::lanes;
   const bool plastic = !fp_inv_.empty();
+  // Local copies of the arrays' pointers: the SSE stores below may alias anything, which
+  // would otherwise reload them from the object at every entry.
+  const std::size_t* const begin = begin_.data();
+  const int* const ctrl = ctrl_.data();
+  const float* const coef = coef_.data();
+  const std::uint32_t* const slot = slot_.data();
   for (std::size_t b = q0; b < q0 + n; b += 4) {
     const int cnt = static_cast<int>(std::min<std::size_t>(4, q0 + n - b));
     // Lane j: point b + j; lanes past the end repeat the last point (results unused).
@@ -123,10 +130,10 @@ void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, cons
         continue;
       }
       for (int i = 0; i < 5; ++i) acc[i][j] = splat(0.0f);
-      const F4 x0 = load3(x[ctrl_[begin_[q]]].data());
-      for (std::size_t e = begin_[q] + 1; e < begin_[q + 1]; ++e) {
-        const F4 dx = load3(x[ctrl_[e]].data()) - x0;
-        const float* c = &coef_[5 * e];
+      const F4 x0 = load3(x[ctrl[begin[q]]].data());
+      for (std::size_t e = begin[q] + 1; e < begin[q + 1]; ++e) {
+        const F4 dx = load3(x[ctrl[e]].data()) - x0;
+        const float* c = &coef[5 * e];
         for (int i = 0; i < 5; ++i) acc[i][j] = acc[i][j] + splat(c[i]) * dx;
       }
     }
@@ -218,11 +225,11 @@ void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, cons
       G[i][3] = reinterpret_cast<F4>(r3);
     }
     for (int j = 0; j < cnt; ++j)
-      for (std::size_t e = begin_[qs[j]]; e < begin_[qs[j] + 1]; ++e) {
-        const float* c = &coef_[5 * e];
+      for (std::size_t e = begin[qs[j]], e1 = begin[qs[j] + 1]; e < e1; ++e) {
+        const float* c = &coef[5 * e];
         const F4 share = splat(c[0]) * G[0][j] + splat(c[1]) * G[1][j] + splat(c[2]) * G[2][j] +
                          splat(c[3]) * G[3][j] + splat(c[4]) * G[4][j];
-        _mm_storeu_ps(&fe[4 * std::size_t(slot_[e])], reinterpret_cast<__m128>(share));
+        _mm_storeu_ps(&fe[4 * std::size_t(slot[e])], reinterpret_cast<__m128>(share));
       }
   }
 }
