@@ -314,13 +314,13 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
   }
   T* const fe = forces ? entry_scratch.data() : nullptr;
   // Per chunk: total and membrane energy.
-  const std::vector<std::array<double, 2>> parts = chunk_parts(
-      nq, kPointGrain, serial, std::array<double, 2>{0.0, 0.0},
-      [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
-        double et = 0.0, em = 0.0;
-        eval_points(b, e - b, x, fe, et, membrane ? &em : nullptr);
-        part = {et, em};
-      });
+  const std::vector<std::array<double, 2>> parts =
+      chunk_parts(nq, kPointGrain, serial, std::array<double, 2>{0.0, 0.0},
+                  [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
+                    double et = 0.0, em = 0.0;
+                    eval_points(b, e - b, x, fe, et, membrane ? &em : nullptr);
+                    part = {et, em};
+                  });
   double et = 0.0, em = 0.0;
   for (const std::array<double, 2>& part : parts) {
     et += part[0];

@@ -230,8 +230,8 @@ class KirchhoffLoveShellT {
 
 /// The four-lane float kernel (sim/shell/kl_batch.cpp).
 template <>
-void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, const Vec3T* x, float* fe,
-                                             double& e_total, double* e_membrane) const;
+void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, const Vec3T* x,
+                                             float* fe, double& e_total, double* e_membrane) const;
 
 using KirchhoffLoveShell = KirchhoffLoveShellT<Real>;
 

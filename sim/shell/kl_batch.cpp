@@ -53,10 +53,8 @@ F4 layer_psi4(float mu, float lambda, const Stiffening& st, const F4 (&Bp)[4], F
   // atanh(x) / x: the series below 1e-2, else log((1 + x) / (1 - x)) / (2 x).
   const F4 x2 = x * x;
   const F4 series =
-      splat(1.0f) +
-      x2 * (splat(1.0f / 3.0f) + x2 * (splat(1.0f / 5.0f) + x2 * splat(1.0f / 7.0f)));
-  const F4 full =
-      splat(0.5f) * log4((splat(1.0f) + x) / (splat(1.0f) - x)) / x;
+      splat(1.0f) + x2 * (splat(1.0f / 3.0f) + x2 * (splat(1.0f / 5.0f) + x2 * splat(1.0f / 7.0f)));
+  const F4 full = splat(0.5f) * log4((splat(1.0f) + x) / (splat(1.0f) - x)) / x;
   const F4 q = x < splat(1e-2f) ? series : full;
   const F4 L = log4(det);
   const F4 D = splat(2.0f) * x * q;
@@ -105,8 +103,7 @@ F4 layer_psi4(float mu, float lambda, const Stiffening& st, const F4 (&Bp)[4], F
 
 template <>
 void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, const Vec3T* x,
-                                             float* fe, double& e_total,
-                                             double* e_membrane) const {
+                                             float* fe, double& e_total, double* e_membrane) const {
   using namespace kl::lanes;
   const bool plastic = !fp_inv_.empty();
   // Local copies of the arrays' pointers: the SSE stores below may alias anything, which
@@ -202,8 +199,8 @@ void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, cons
     // Backpropagation through v_a = (I - a3 a3^T) m_a / l (eval_kinematics).
     const V3 PG1 = Gv1 - dot(a3, Gv1) * a3, PG2 = Gv2 - dot(a3, Gv2) * a3;
     const V3 cm1 = inv_l * PG1, cm2 = inv_l * PG2;
-    const V3 sum = dot(a3, t1) * PG1 + dot(a3, Gv1) * v1 + dot(Gv1, v1) * a3 +
-                   dot(a3, t2) * PG2 + dot(a3, Gv2) * v2 + dot(Gv2, v2) * a3;
+    const V3 sum = dot(a3, t1) * PG1 + dot(a3, Gv1) * v1 + dot(Gv1, v1) * a3 + dot(a3, t2) * PG2 +
+                   dot(a3, Gv2) * v2 + dot(Gv2, v2) * a3;
     const V3 cn = (splat(0.0f) - inv_l) * sum;
     Ga1 = Ga1 + (cross(a12, cm1) + cross(a22, cm2) + cross(a2, cn));
     Ga2 = Ga2 + (cross(cm1, a11) + cross(cm2, a12) + cross(cn, a1));

@@ -20,10 +20,16 @@ namespace shellmpm::kl::lanes {
 typedef float F4 __attribute__((vector_size(16)));
 typedef std::int32_t I4 __attribute__((vector_size(16)));
 
-[[gnu::always_inline]] inline F4 splat(float s) { return F4{s, s, s, s}; }
-[[gnu::always_inline]] inline F4 sqrt4(F4 a) { return reinterpret_cast<F4>(_mm_sqrt_ps(reinterpret_cast<__m128>(a))); }
+[[gnu::always_inline]] inline F4 splat(float s) {
+  return F4{s, s, s, s};
+}
+[[gnu::always_inline]] inline F4 sqrt4(F4 a) {
+  return reinterpret_cast<F4>(_mm_sqrt_ps(reinterpret_cast<__m128>(a)));
+}
 /// std::max(a, b) lane by lane (a where b < a is false, so a NaN a stays).
-[[gnu::always_inline]] inline F4 max4(F4 a, F4 b) { return a < b ? b : a; }
+[[gnu::always_inline]] inline F4 max4(F4 a, F4 b) {
+  return a < b ? b : a;
+}
 
 inline F4 log4(F4 x) {
   const I4 bits = reinterpret_cast<I4>(x);
@@ -65,7 +71,9 @@ struct V3 {
 [[gnu::always_inline]] inline V3 operator-(const V3& a, const V3& b) {
   return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
-[[gnu::always_inline]] inline V3 operator*(F4 s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
+[[gnu::always_inline]] inline V3 operator*(F4 s, const V3& a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
 [[gnu::always_inline]] inline F4 dot(const V3& a, const V3& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }

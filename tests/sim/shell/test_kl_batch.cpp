@@ -1,0 +1,123 @@
+// The four-lane float Kirchhoff-Love kernel (sim/shell/kl_batch.cpp) and its lane
+// logarithm (sim/shell/kl_lanes.h).
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "sim/shell/kirchhoff_love.h"
+#include "sim/shell/kl_lanes.h"
+#include "tests/support/bezier_test_basis.h"
+
+using namespace shellmpm;
+using shellmpm_test::BezierShell;
+
+namespace {
+
+/// Distance in units in the last place between two finite floats of the same sign.
+long ulp_distance(float a, float b) {
+  std::int32_t ia, ib;
+  std::memcpy(&ia, &a, 4);
+  std::memcpy(&ib, &b, 4);
+  return std::labs(static_cast<long>(ia) - static_cast<long>(ib));
+}
+
+float lane_log(float x) {
+  const kl::lanes::F4 r = kl::lanes::log4(kl::lanes::F4{x, 1.0f, 2.0f, 0.5f});
+  return r[0];
+}
+
+ShellMaterialDesc metal() {
+  ShellMaterialDesc m;
+  m.youngs_modulus = 1e9;
+  m.poisson_ratio = 0.3;
+  m.density = 2700;
+  m.thickness = 0.01;
+  m.yield_stress = 2e6;
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("the lane logarithm is within 2 ulp of std::log, with its special values", "[kl]") {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> mant(1.0f, 2.0f);
+  std::uniform_int_distribution<int> expo(-120, 120);
+  long worst = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const float x = std::ldexp(mant(rng), expo(rng));
+    const float ref = static_cast<float>(std::log(static_cast<double>(x)));
+    const float got = lane_log(x);
+    if (std::abs(ref) < 1e-30f) continue;
+    if ((ref > 0) != (got > 0)) {
+      CHECK(std::abs(got - ref) < 1e-7f);
+      continue;
+    }
+    worst = std::max(worst, ulp_distance(got, ref));
+  }
+  // Near 1 (log x ~ x - 1, the hardest place for relative accuracy).
+  for (int i = -2000; i <= 2000; ++i) {
+    const float x = 1.0f + static_cast<float>(i) * 1e-6f;
+    if (x == 1.0f) continue;
+    const float ref = static_cast<float>(std::log(static_cast<double>(x)));
+    worst = std::max(worst, ulp_distance(lane_log(x), ref));
+  }
+  INFO("worst " << worst << " ulp");
+  CHECK(worst <= 2);
+  CHECK(lane_log(1.0f) == 0.0f);
+  CHECK(std::isinf(lane_log(0.0f)));
+  CHECK(lane_log(0.0f) < 0);
+  CHECK(std::isnan(lane_log(-1.0f)));
+  CHECK(std::isnan(lane_log(std::numeric_limits<float>::quiet_NaN())));
+  CHECK(std::isinf(lane_log(std::numeric_limits<float>::infinity())));
+}
+
+TEST_CASE(
+    "the float KL kernel matches double with plasticity, past the stretch limit and "
+    "in a part batch",
+    "[kl]") {
+  // 3 x 3 patches, two triangles each, 7-point rules: 126 points, not a multiple of four.
+  const BezierShell s = shellmpm_test::make_bezier_grid(3, 3, 7);
+  REQUIRE(s.points.size() % 4 != 0);
+  const std::vector<Eigen::Vector3d> rest =
+      shellmpm_test::interpolate(s, [](const Eigen::Vector2d& uv) {
+        return Eigen::Vector3d(uv.x(), uv.y(), 0.2 * std::sin(2.0 * uv.x()) * uv.y());
+      });
+  KirchhoffLoveShellT<double> shd(s.points, s.weights, rest, metal(), 3);
+  KirchhoffLoveShellT<float> shf(s.points, s.weights, rest, metal(), 3);
+  // A stored plastic state: every layer a different F^P near identity.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> pd = shd.plastic_state();
+  for (std::size_t i = 0; i < pd.size(); ++i) pd[i] += 0.05 * u(rng);
+  shd.set_plastic_state(pd);
+  shf.set_plastic_state(std::vector<float>(pd.begin(), pd.end()));
+  // Stretched 1.9x along x (past the default stretch limit 1.5) on one side, bent and
+  // perturbed everywhere.
+  std::vector<Eigen::Vector3d> x = rest;
+  for (Eigen::Vector3d& p : x) {
+    if (p.x() > 0.5) p.x() = 0.5 + 1.9 * (p.x() - 0.5);
+    p.z() += 0.1 * p.x() * p.x() + 0.01 * u(rng);
+  }
+  std::vector<Eigen::Vector3d> fd(x.size(), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3f> xf(x.size()), ff(x.size(), Eigen::Vector3f::Zero());
+  for (std::size_t i = 0; i < x.size(); ++i) xf[i] = x[i].cast<float>();
+  const double ed = shd.energy(x.data(), fd.data()).total;
+  const auto ef = shf.energy(xf.data(), ff.data());
+  CHECK(shd.max_strain(x.data()) > std::log(1.5));  // the stretch term is on somewhere
+  CHECK(double(ef.total) == Approx(ed).epsilon(1e-4));
+  double scale = 0;
+  for (const auto& f : fd) scale = std::max(scale, f.norm());
+  REQUIRE(scale > 0);
+  for (std::size_t i = 0; i < x.size(); ++i)
+    CHECK((ff[i].cast<double>() - fd[i]).norm() < 1e-4 * scale);
+  // The membrane diagnostic does not change the total or the forces.
+  std::vector<Eigen::Vector3f> ff2(x.size(), Eigen::Vector3f::Zero());
+  const auto ef2 = shf.energy(xf.data(), ff2.data(), false, false);
+  CHECK(ef2.total == ef.total);
+  CHECK(std::memcmp(ff2.data(), ff.data(), ff.size() * sizeof(Eigen::Vector3f)) == 0);
+  CHECK(ef.membrane > 0);
+}
