@@ -231,7 +231,8 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
   // ShellObject: state, Loop basis fans, Kirchhoff-Love data, the output limit mesh.
   const double object = V * (2 * kVec3 + R + 24 + 1 + 4) + 12 * T;
   const double basis = 12 * T + 8 * V + 12 * T + 12 * T + V;
-  const double kl = entries * (16 + 6 * R) + qp * (8 + R + 4 * R * layers + 4 * R) +
+  // Per entry its control point and gather slot (4 + 4), coefficients and value (6 R).
+  const double kl = entries * (8 + 6 * R) + qp * (8 + R + 4 * R * layers + 4 * R) +
                     (m.yield_stress > 0 ? qp * 4 * R * layers : 0) + 8 * V;
   const double limit = limit_mesh_bytes(Vout, Tout, S, c.has_uvs);
   const double persistent = object + basis + kl + limit + V * kVec3;  // + force buffer
@@ -244,7 +245,8 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
       std::max(t.construction, t.shells_persistent + object + basis + kl + points + rest_mesh);
   t.shells_persistent += persistent;
   t.shell_bytes += persistent;
-  t.force_scratch = std::max(t.force_scratch, 15 * R * qp);  // adjoints per quadrature point
+  // Each entry's force share (4 scalars, kept per calling thread).
+  t.force_scratch = std::max(t.force_scratch, 4 * R * entries);
 
   if (!shell_contact_on(scene, i)) return;
   ++t.grid_shells;
