@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -304,14 +305,20 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
                                                                        bool membrane) const {
   const std::size_t nq = area_.size();
   // Each basis entry's share of its control point's force, in gather order (eval_points
-  // writes every one). Kept per calling thread between calls: a fresh array each call
-  // (36 MB on a 100k-point sheet) cost its page faults every time.
-  thread_local std::vector<T> entry_scratch;
+  // writes every one). The object keeps the array between calls (a fresh one per call, 36 MB
+  // on a 100k-point sheet, cost its page faults every time: a third of a force
+  // evaluation); a call that finds it in use by another thread takes its own.
   const std::size_t ne = slot_.size();
-  if (forces && entry_scratch.size() < 4 * ne) {
-    std::vector<T>().swap(entry_scratch);
-    entry_scratch.resize(4 * ne);
-  }
+  std::vector<T> own;
+  const bool shared = forces && !scratch_.busy.test_and_set(std::memory_order_acquire);
+  std::vector<T>& entry_scratch = shared ? scratch_.shares : own;
+  if (forces && entry_scratch.size() < 4 * ne) entry_scratch.resize(4 * ne);
+  struct Release {
+    std::atomic_flag* flag;
+    ~Release() {
+      if (flag) flag->clear(std::memory_order_release);
+    }
+  } release{shared ? &scratch_.busy : nullptr};
   T* const fe = forces ? entry_scratch.data() : nullptr;
   // Per chunk: total and membrane energy.
   const std::vector<std::array<double, 2>> parts =

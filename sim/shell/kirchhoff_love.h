@@ -61,6 +61,7 @@
 #pragma once
 #include <Eigen/Core>
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -226,6 +227,16 @@ class KirchhoffLoveShellT {
   // entry e's.
   std::vector<std::size_t> gather_begin_;
   std::vector<std::uint32_t> slot_;
+  // energy()'s per-entry force shares (4 per entry), kept between calls; busy marks it in
+  // use (a concurrent call takes its own). A copy of the object starts without one.
+  struct ForceScratch {
+    std::vector<T> shares;
+    std::atomic_flag busy = ATOMIC_FLAG_INIT;
+    ForceScratch() = default;
+    ForceScratch(const ForceScratch&) {}
+    ForceScratch& operator=(const ForceScratch&) { return *this; }
+  };
+  mutable ForceScratch scratch_;
 };
 
 /// The four-lane float kernel (sim/shell/kl_batch.cpp).

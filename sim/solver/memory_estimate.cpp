@@ -204,7 +204,7 @@ double grid_bytes(double points, double pblocks, double gblocks) {
 
 /// What the shells hold and build, summed over the shells (estimate_solver_memory).
 struct ShellTotals {
-  double shells_persistent = 0, construction = 0, grid_points = 0, force_scratch = 0;
+  double shells_persistent = 0, construction = 0, grid_points = 0;
   double contact_bytes = 0, integrity_bytes = 0, shell_bytes = 0, guard_bytes = 0;
   std::size_t grid_shells = 0;
   std::vector<double> shell_pblocks;  ///< particle blocks of each shell on the grid
@@ -235,7 +235,9 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
   const double kl = entries * (8 + 6 * R) + qp * (8 + R + 4 * R * layers + 4 * R) +
                     (m.yield_stress > 0 ? qp * 4 * R * layers : 0) + 8 * V;
   const double limit = limit_mesh_bytes(Vout, Tout, S, c.has_uvs);
-  const double persistent = object + basis + kl + limit + V * kVec3;  // + force buffer
+  // + the force buffer, and the Kirchhoff-Love force shares kept between steps (4 scalars
+  // per entry).
+  const double persistent = object + basis + kl + limit + V * kVec3 + 4 * R * entries;
   // While the Kirchhoff-Love data is built: every quadrature point's BasisPoint (seven
   // vectors grown by push_back), the weights and the rest mesh passed in.
   const double cap = grown(S);
@@ -245,8 +247,6 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
       std::max(t.construction, t.shells_persistent + object + basis + kl + points + rest_mesh);
   t.shells_persistent += persistent;
   t.shell_bytes += persistent;
-  // Each entry's force share (4 scalars, kept per calling thread).
-  t.force_scratch = std::max(t.force_scratch, 4 * R * entries);
 
   if (!shell_contact_on(scene, i)) return;
   ++t.grid_shells;
@@ -369,8 +369,7 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
                {"shell guard", t.guard_bytes}};
   double held = 0;
   for (const MemoryPart& p : out.parts) held += p.bytes;
-  // A step: the adjoints of the largest shell's forces; an emitting run also copies one
-  // particle attribute (a Mat3) when its arrays double.
+  // A step: an emitting run copies one particle attribute (a Mat3) when its arrays double.
   const double growth = n.emitted_particles > 0 ? kMat3 * n.peak_particles() : 0;
   // After each frame the particles are sorted by block, one 4-byte word of every attribute
   // at a time through a scratch word per particle (sim/mpm/particles.cpp).
@@ -398,8 +397,7 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
       implicit_shells += 105 * std::pow(n.largest_shell, 1.5);
   }
   out.held_bytes = held;
-  out.step_scratch = std::max(
-      {t.force_scratch + contact_scratch + implicit_grid + implicit_shells, growth, permute});
+  out.step_scratch = std::max({contact_scratch + implicit_grid + implicit_shells, growth, permute});
   // Built: the shells one by one, then contact and integrity, then the fill particles
   // (every source's points in a vector of Vec3d, up to doubled by push_back, all held
   // while the particle arrays, allocated once at their final size, take them in).
