@@ -39,12 +39,8 @@ template <class Stiffening>
 F4 layer_psi4(float mu, float lambda, const Stiffening& st, const F4 (&Bp)[4], F4 m11, F4 m12,
               F4 m22, F4 (&S)[3]) {
   using namespace kl::lanes;
-  const F4 b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
-  const F4 mb0x = m11 * b00 + m12 * b10, mb0y = m12 * b00 + m22 * b10;
-  const F4 mb1x = m11 * b01 + m12 * b11, mb1y = m12 * b01 + m22 * b11;
-  const F4 c11 = b00 * mb0x + b10 * mb0y;
-  const F4 c12 = b00 * mb1x + b10 * mb1y;
-  const F4 c22 = b01 * mb1x + b11 * mb1y;
+  F4 c11, c12, c22;
+  kl::layer_metric(Bp, m11, m12, m22, c11, c12, c22);
   const F4 tr = c11 + c22;
   const F4 det = c11 * c22 - c12 * c12;
   const F4 hd = splat(0.5f) * (c11 - c22);
@@ -90,12 +86,7 @@ F4 layer_psi4(float mu, float lambda, const Stiffening& st, const F4 (&Bp)[4], F
     s12 = beyond ? s12 + sc * c12 : s12;
     s22 = beyond ? s22 + (si + sc * c22) : s22;
   }
-  // dpsi/dM = Bp S_C Bp^T
-  const F4 r00 = b00 * s11 + b01 * s12, r01 = b00 * s12 + b01 * s22;
-  const F4 r10 = b10 * s11 + b11 * s12, r11 = b10 * s12 + b11 * s22;
-  S[0] = r00 * b00 + r01 * b01;
-  S[1] = r00 * b10 + r01 * b11;
-  S[2] = r10 * b10 + r11 * b11;
+  kl::metric_adjoint(Bp, s11, s12, s22, S);
   return psi;
 }
 

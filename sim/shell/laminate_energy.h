@@ -30,6 +30,18 @@ inline void layer_metric(const T* Bp, T m11, T m12, T m22, T& c11, T& c12, T& c2
   c22 = b01 * mb1x + b11 * mb1y;
 }
 
+/// dpsi/dM = Bp S_C Bp^T from dpsi/dC = [s11 s12; s12 s22] (Bp row-major): S = (S_11,
+/// S_12, S_22). T may be a scalar or a lane vector (sim/shell/kl_batch.cpp).
+template <class T>
+inline void metric_adjoint(const T* Bp, T s11, T s12, T s22, T* S) {
+  const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
+  const T r00 = b00 * s11 + b01 * s12, r01 = b00 * s12 + b01 * s22;
+  const T r10 = b10 * s11 + b11 * s12, r11 = b10 * s12 + b11 * s22;
+  S[0] = r00 * b00 + r01 * b01;
+  S[1] = r00 * b10 + r01 * b11;
+  S[2] = r10 * b10 + r11 * b11;
+}
+
 /// Laminate energy density of one layer (supplement secs. 3-4) from the current metric
 /// M = [g_a . g_b] (m11, m12, m22) and Bp (row-major 2x2): C = Bp^T M Bp has eigenvalues
 /// s_a^2 and psi = mu/4 |log C|^2 + lambda/8 (log det C)^2 = mu |log s|^2 +
@@ -45,7 +57,6 @@ inline void layer_metric(const T* Bp, T m11, T m12, T m22, T& c11, T& c12, T& c2
 /// cancellation at s_1 = s_2). Only s_1 > s_l >= s_2: c_1 - c_2 = 2h >= s_1^2 - s_l^2 > 0.
 template <class T, class Stiffening>
 inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m12, T m22, T* S) {
-  const T b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
   T c11, c12, c22;
   layer_metric(Bp, m11, m12, m22, c11, c12, c22);
   const T tr = c11 + c22;
@@ -87,12 +98,7 @@ inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m
       s12 += stretch_c * c12;
       s22 += stretch_i + stretch_c * c22;
     }
-    // dpsi/dM = Bp S_C Bp^T
-    const T r00 = b00 * s11 + b01 * s12, r01 = b00 * s12 + b01 * s22;
-    const T r10 = b10 * s11 + b11 * s12, r11 = b10 * s12 + b11 * s22;
-    S[0] = r00 * b00 + r01 * b01;
-    S[1] = r00 * b10 + r01 * b11;
-    S[2] = r10 * b10 + r11 * b11;
+    metric_adjoint(Bp, s11, s12, s22, S);
   }
   return psi;
 }
