@@ -5,7 +5,6 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <utility>
 
 #include "sim/core/check.h"
