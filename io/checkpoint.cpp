@@ -18,7 +18,7 @@
 namespace shellmpm {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '3'};
+constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '4'};
 constexpr char kEndMagic[8] = {'S', 'H', 'M', 'P', 'M', 'E', 'N', 'D'};
 constexpr std::size_t kHeaderBytes = 8 + 4 + 8;  // magic, sizeof(Real), payload size
 constexpr std::size_t kTrailerBytes = 4 + 8;     // CRC-32, end magic
@@ -62,8 +62,9 @@ void put_payload(Sink& s, const Checkpoint& c) {
   put_vec(s, p.v);
   put_vec(s, p.C);
   put_vec(s, p.F);
-  put_vec(s, p.volume);
-  put_vec(s, p.material);
+  put_vec(s, p.kind_material);
+  put_vec(s, p.kind_volume);
+  put_vec(s, p.kind);
   put_vec(s, p.id);
   put_vec(s, p.plastic);
   put<std::uint64_t>(s, c.stats_json.size());
@@ -157,8 +158,11 @@ void parse_payload(Cursor& in, Checkpoint& c) {
   in.get_vec(p.v, "particle velocities", n);
   in.get_vec(p.C, "particle APIC matrices", n);
   in.get_vec(p.F, "particle deformation gradients", n);
-  in.get_vec(p.volume, "particle volumes", n);
-  in.get_vec(p.material, "particle materials", n);
+  in.get_vec(p.kind_material, "particle kind materials");
+  const std::size_t nk = p.kind_material.size();
+  if (nk > 65536) in.fail("particle kind count " + std::to_string(nk) + " is above 65536");
+  in.get_vec(p.kind_volume, "particle kind volumes", nk);
+  in.get_vec(p.kind, "particle kinds", n);
   in.get_vec(p.id, "particle ids", n);
   in.get_vec(p.plastic, "particle plastic state", p.keep_plastic ? n : 0);
   require_finite(in, p.x, "particle position");
@@ -166,9 +170,13 @@ void parse_payload(Cursor& in, Checkpoint& c) {
   require_finite(in, p.C, "particle APIC matrix");
   require_finite(in, p.F, "particle deformation gradient");
   require_finite(in, p.plastic, "particle plastic state");
+  for (std::size_t k = 0; k < nk; ++k)
+    if (!(p.kind_volume[k] > 0) || !std::isfinite(p.kind_volume[k]))
+      in.fail("particle kind volume[" + std::to_string(k) + "] is not positive and finite");
   for (std::size_t i = 0; i < n; ++i) {
-    if (!(p.volume[i] > 0) || !std::isfinite(p.volume[i]))
-      in.fail("particle volume[" + std::to_string(i) + "] is not positive and finite");
+    if (p.kind[i] >= nk)
+      in.fail("particle kind[" + std::to_string(i) + "] is " + std::to_string(p.kind[i]) +
+              ", not below the kind count " + std::to_string(nk));
     if (p.id[i] >= p.next_id)
       in.fail("particle id[" + std::to_string(i) + "] is not below next id " +
               std::to_string(p.next_id));
@@ -298,10 +306,10 @@ void restore_checkpoint(Solver& solver, Checkpoint&& c, const std::string& path)
   const Scene& scene = solver.scene();
   const ParticleSet& p = c.particles;
   const std::size_t nmat = scene.materials.size();
-  for (std::size_t i = 0; i < p.size(); ++i)
-    if (p.material[i] >= nmat)
-      throw refuse("particle " + std::to_string(i) + " has material index " +
-                   std::to_string(p.material[i]) + ", the scene has " + std::to_string(nmat) +
+  for (std::size_t k = 0; k < p.kind_material.size(); ++k)
+    if (p.kind_material[k] >= nmat)
+      throw refuse("particle kind " + std::to_string(k) + " has material index " +
+                   std::to_string(p.kind_material[k]) + ", the scene has " + std::to_string(nmat) +
                    " materials");
   if (p.keep_plastic != solver.particles().keep_plastic)
     throw refuse(p.keep_plastic ? "it has plastic state the scene's materials do not use"

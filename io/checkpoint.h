@@ -1,8 +1,8 @@
 // Checkpoints: the full solver state at the end of a frame, so `--resume` continues a
 // killed run and produces output bit-identical to an uninterrupted one.
 //
-// File layout (little-endian), format 3:
-//   header   "SHMPMCK3", u32 sizeof(Real), u64 payload size
+// File layout (little-endian), format 4 (particle kinds: a material and rest volume each):
+//   header   "SHMPMCK4", u32 sizeof(Real), u64 payload size
 //   payload  scene fingerprint, frame, time, particles, statistics, shells (checkpoint.cpp)
 //   trailer  u32 CRC-32 of header and payload (io/checksum.h), "SHMPMEND"
 // A damaged file (any byte changed, truncated, extended) fails the length or checksum

@@ -113,7 +113,7 @@ std::vector<std::pair<std::uint64_t, std::size_t>> particles_by_leaf(const Densi
     for (std::size_t p = b; p < e; ++p) {
       const Vec3& x = in.positions[p];
       std::array<int, 3> leaf{};
-      bool ok = std::isfinite(static_cast<double>(in.volumes[p])) && in.volumes[p] >= 0;
+      bool ok = std::isfinite(static_cast<double>(in.volume(p))) && in.volume(p) >= 0;
       for (int a = 0; a < 3 && ok; ++a) {
         const double g = static_cast<double>(x[a]) * inv_h;
         ok = std::isfinite(g) && std::abs(g) < kMaxIndex;
@@ -130,7 +130,7 @@ std::vector<std::pair<std::uint64_t, std::size_t>> particles_by_leaf(const Densi
     if (c < n) {
       std::ostringstream os;
       os << "write_density_vdb: particle " << c << " has position " << describe(in.positions[c])
-         << " and volume " << in.volumes[c] << " (non-finite, negative volume, or beyond "
+         << " and volume " << in.volume(c) << " (non-finite, negative volume, or beyond "
          << kMaxIndex << " voxels from the origin)";
       throw std::invalid_argument(os.str());
     }
@@ -295,7 +295,7 @@ void write_density_vdb(const std::string& path, const DensityInput& in, const Vd
       for (int a = 0; a < 3; ++a) {
         const Stencil1 s1 = stencil(static_cast<double>(in.positions[p][a]) * inv_h);
         st[s].base[a] = s1.base;
-        const double scale = a == 0 ? static_cast<double>(in.volumes[p]) : 1.0;
+        const double scale = a == 0 ? static_cast<double>(in.volume(p)) : 1.0;
         for (int q = 0; q < 3; ++q) st[s].w[a][q] = scale * s1.w[q];
       }
       if (want_vel) vel_sorted[s] = in.velocities[p].template cast<double>();

@@ -17,6 +17,11 @@ struct DensityInput {
   const Vec3* velocities = nullptr;  ///< [m/s]; may be null when no "vel" grid is asked for
   const Real* volumes = nullptr;     ///< particle volume = mass / rest density [m^3], >= 0
   std::size_t count = 0;
+  /// When set, `volumes` is per kind (ParticleSet::kind_volume): particle p's volume is
+  /// volumes[kinds[p]].
+  const std::uint16_t* kinds = nullptr;
+
+  Real volume(std::size_t p) const { return kinds ? volumes[kinds[p]] : volumes[p]; }
 };
 
 /// How to write the volume.

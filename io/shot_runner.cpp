@@ -23,7 +23,7 @@ void write_frame_outputs(const Scene& scene, const Solver& solver, int frame) {
   const OutputSettings& o = scene.output;
   const ParticleSet& p = solver.particles();
   if (o.density && !scene.sources.empty()) {
-    DensityInput in{p.x.data(), p.v.data(), p.volume.data(), p.size()};
+    DensityInput in{p.x.data(), p.v.data(), p.kind_volume.data(), p.size(), p.kind.data()};
     VdbOptions vo;
     vo.voxel_size = o.voxel_size > 0 ? o.voxel_size : scene.shot.dx;
     vo.velocity = o.velocity;

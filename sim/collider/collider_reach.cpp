@@ -37,8 +37,7 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
           if (colliders[k].bounds().overlaps(box) && colliders[k].phi(centre) <= radius + reach)
             near |= 1u << k;
         if (!near) return;
-        for (std::uint32_t s = grid.pblock_start[b]; s < grid.pblock_start[b + 1]; ++s) {
-          const std::uint32_t i = grid.order[s];
+        grid.for_each_point(b, [&](std::uint32_t i) {
           const Vec3& p = i < nf ? (*first)[i] : x[i - nf];
           const Vec3d pd = p.cast<double>();
           const Vec3d pe = pd + dt * (i < nf ? (*first_v)[i] : v[i - nf]).cast<double>();
@@ -46,14 +45,14 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
           for (std::size_t k = 0; k < nk; ++k)
             if (((near >> k) & 1u) && std::min(colliders[k].phi(pd), colliders[k].phi(pe)) <= reach)
               bits |= 1u << k;
-          if (!bits) continue;
+          if (!bits) return;
           const QuadraticWeights W(grid.grid_coord(p));
           const int lx = W.base[0] - corner[0], ly = W.base[1] - corner[1],
                     lz = W.base[2] - corner[2];
           for (int a = 0; a < 3; ++a)
             for (int c = 0; c < 3; ++c)
               for (int d = 0; d < 3; ++d) buf[pad_node(lx + a, ly + c, lz + d)] |= bits;
-        }
+        });
       },
       serial);
   mask_.assign(grid.num_grid_blocks() * kBlockNodes, 0);

@@ -83,7 +83,7 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
         Node::clear(buf.data(), buf.size());
         const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
         for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
-          const std::uint32_t j = F.grid.order[q];
+          const std::uint32_t j = F.grid.order()[q];
           const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
           const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, folds_);
           for_each_stencil_node(
@@ -146,7 +146,7 @@ void ShellFields::bulk_moments(const SparseGrid& combined, const ParticleSet& bu
         auto& buf = bulk_buf_[b];
         std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
         const Vec3i bc = unpack_block(combined.pblock_key[b]) * kBlockSize;
-        const auto* o = combined.order.data();
+        const auto* o = combined.order().data();
         const std::uint32_t s1 = combined.pblock_start[b + 1];
         // Bulk particles follow the shell points in each block's sorted slice.
         const std::uint32_t s0 = static_cast<std::uint32_t>(
@@ -154,7 +154,7 @@ void ShellFields::bulk_moments(const SparseGrid& combined, const ParticleSet& bu
         for (std::uint32_t q = s0; q < s1; ++q) {
           const std::uint32_t p = o[q] - first_bulk;
           const QuadraticWeights W(combined.grid_coord(bulk.x[p]));
-          const Real m = bulk.volume[p];  // volume-weighted: the densities cancel in a centroid
+          const Real m = bulk.volume_of(p);  // volume-weighted: the densities cancel in a centroid
           for_each_stencil_node(W, bc, [&](const StencilNode& n) {
             const Real w = n.w * m;
             Moment& nd = buf[n.pad()];
@@ -392,7 +392,7 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
           const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
           const auto& nbr = F.grid.pblock_nbr[b];
           for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
-            const std::uint32_t j = F.grid.order[q];
+            const std::uint32_t j = F.grid.order()[q];
             const QuadraticWeights W(F.grid.grid_coord(F.x0[j]));
             const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
             Vec3 dv = Vec3::Zero();

@@ -80,7 +80,7 @@ void ShellFields::scatter_classes(Field& F, const GridShell& gs, Real dt, bool s
         const Vec3i bc = unpack_block(G.pblock_key[b]) * kBlockSize;
         const auto& nbr = G.pblock_nbr[b];
         for (std::uint32_t q = G.pblock_start[b]; q < G.pblock_start[b + 1]; ++q) {
-          const std::uint32_t j = G.order[q];
+          const std::uint32_t j = G.order()[q];
           const QuadraticWeights W(G.grid_coord(sh.x[j]));
           const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, true);
           for_each_stencil_node(W, bc, [&](const StencilNode& n) {

@@ -413,8 +413,8 @@ void ShellGuard::load_bulk(const GuardBulk& bulk, double dt) {
     const std::size_t p = bulk_idx_[k];
     v_[np + k] = to_d(ps.v[p]);
     bulk_x0_[k] = to_d(ps.x[p]) - dt * v_[np + k];
-    const double m =
-        static_cast<double>(ps.volume[p]) * static_cast<double>((*bulk.densities)[ps.material[p]]);
+    const double m = static_cast<double>(ps.volume_of(p)) *
+                     static_cast<double>((*bulk.densities)[ps.material_of(p)]);
     inv_mass_[np + k] = Vec3d::Constant(m > 0 ? 1.0 / m : 0.0);
   }
 }

@@ -67,7 +67,7 @@ namespace {
 // Slice of block b's order entries holding shell points of one kind: [lo, hi).
 std::pair<std::uint32_t, std::uint32_t> slice(const SparseGrid& grid, std::size_t b,
                                               std::uint32_t lo_index, std::uint32_t hi_index) {
-  const auto* o = grid.order.data();
+  const auto* o = grid.order().data();
   const std::uint32_t s0 = grid.pblock_start[b], s1 = grid.pblock_start[b + 1];
   const auto lo = std::lower_bound(o + s0, o + s1, lo_index) - o;
   const auto hi = std::lower_bound(o + lo, o + s1, hi_index) - o;
@@ -83,7 +83,7 @@ void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
   for (std::uint32_t s = lo; s < hi; ++s) {
-    const std::uint32_t g = grid.order[s];
+    const std::uint32_t g = grid.order()[s];
     const GridShell& gs = shells[table.shell(g)];
     const std::uint32_t j = table.local(g);
     const ShellObject& sh = *gs.shell;
@@ -103,7 +103,7 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
   for (std::uint32_t s = lo; s < hi; ++s) {
-    const std::uint32_t g = grid.order[s];
+    const std::uint32_t g = grid.order()[s];
     GridShell& gs = shells[table.shell(g)];
     const std::uint32_t j = table.local(g);
     if (g < nc) {
@@ -153,7 +153,7 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
         const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
         const Real dx = static_cast<Real>(grid.dx());
         for (std::uint32_t s = lo; s < hi; ++s) {
-          const std::uint32_t g = grid.order[s];
+          const std::uint32_t g = grid.order()[s];
           const ShellContact& c = *shells[table.shell(g)].contact;
           const std::uint32_t p = table.local(g);
           const Vec3& G3 = c.G3[p];

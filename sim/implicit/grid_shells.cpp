@@ -27,7 +27,7 @@ std::size_t node_of(const SparseGrid& grid, std::size_t b, int px, int py, int p
 template <class F>
 void each_shell_point(const SparseGrid& grid, std::size_t b, std::uint32_t count, F&& f) {
   for (std::uint32_t s = grid.pblock_start[b]; s < grid.pblock_start[b + 1]; ++s) {
-    const std::uint32_t g = grid.order[s];
+    const std::uint32_t g = grid.order()[s];
     if (g >= count) break;
     f(g);
   }

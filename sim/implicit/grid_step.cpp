@@ -222,8 +222,8 @@ class GridObjective final : public ImplicitObjective {
   void each_particle(std::size_t b, F&& f) const {
     const Vec3i corner = unpack_block(grid_.pblock_key[b]) * kBlockSize;
     for (std::uint32_t s = grid_.pblock_start[b]; s < grid_.pblock_start[b + 1]; ++s) {
-      if (grid_.order[s] < in_.first_bulk) continue;  // a shell point
-      const std::uint32_t q = grid_.order[s] - in_.first_bulk;
+      if (grid_.order()[s] < in_.first_bulk) continue;  // a shell point
+      const std::uint32_t q = grid_.order()[s] - in_.first_bulk;
       f(q, QuadraticWeights(grid_.grid_coord(in_.particles->x[q])), corner);
     }
   }
@@ -258,8 +258,8 @@ class GridObjective final : public ImplicitObjective {
               const Mat3d Fn = p.F[q].cast<double>();
               const Mat3d F = (Mat3d::Identity() + dt_ * gradv) * Fn;
               const double pl = p.has_plastic() ? static_cast<double>(p.plastic[q]) : 0.0;
-              const ConstitutiveModelT<double>& model = (*in_.models)[p.material[q]];
-              const double V = static_cast<double>(p.volume[q]);
+              const ConstitutiveModelT<double>& model = (*in_.models)[p.material_of(q)];
+              const double V = static_cast<double>(p.volume_of(q));
               e += V * model.energy(F, pl);
               if (!forces) return;
               const Mat3d G = (dt_ * V) * model.first_piola(F, pl) * Fn.transpose();
@@ -293,8 +293,9 @@ class GridObjective final : public ImplicitObjective {
           fbuf_[b].fill(Vec3d::Zero());
           each_particle(b, [&](std::uint32_t q, const QuadraticWeights& W, const Vec3i& c) {
             const double pl = p.has_plastic() ? static_cast<double>(p.plastic[q]) : 0.0;
-            const double k = static_cast<double>(p.volume[q]) *
-                             (*in_.models)[p.material[q]].wave_modulus(p.F[q].cast<double>(), pl);
+            const double k =
+                static_cast<double>(p.volume_of(q)) *
+                (*in_.models)[p.material_of(q)].wave_modulus(p.F[q].cast<double>(), pl);
             for_each_node(W, c, [&](const StencilNodeD& s) {
               fbuf_[b][s.pad] += Vec3d::Constant(k * grad_weight(W, s).squaredNorm());
             });

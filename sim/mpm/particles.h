@@ -8,17 +8,27 @@
 namespace shellmpm {
 
 /// Structure of arrays. Mass is volume * rest density of the particle's material.
+///
+/// A particle's material and rest volume are those of its kind: the particles of one
+/// source share both (one sampling spacing), so they are kept once per kind, not per
+/// particle (a 2-byte kind instead of a 4-byte volume and a 2-byte material).
 struct ParticleSet {
-  std::vector<Vec3> x;                  ///< position [m]
-  std::vector<Vec3> v;                  ///< velocity [m/s]
-  std::vector<Mat3> C;                  ///< APIC affine velocity matrix [1/s]
-  std::vector<Mat3> F;                  ///< (elastic) deformation gradient
-  std::vector<Real> volume;             ///< rest volume V0 [m^3]
-  std::vector<std::uint16_t> material;  ///< index into the solver's material table
-  std::vector<std::uint32_t> id;        ///< stable id, in order of creation
-  std::vector<Real> plastic;            ///< plastic scalar; empty when no material needs it
+  std::vector<Vec3> x;              ///< position [m]
+  std::vector<Vec3> v;              ///< velocity [m/s]
+  std::vector<Mat3> C;              ///< APIC affine velocity matrix [1/s]
+  std::vector<Mat3> F;              ///< (elastic) deformation gradient
+  std::vector<std::uint16_t> kind;  ///< index into kind_material and kind_volume
+  std::vector<std::uint32_t> id;    ///< stable id, in order of creation
+  std::vector<Real> plastic;        ///< plastic scalar; empty when no material needs it
+  /// Per kind: index into the solver's material table, and rest volume V0 [m^3].
+  std::vector<std::uint16_t> kind_material;
+  std::vector<Real> kind_volume;
 
   std::size_t size() const { return x.size(); }
+  std::uint16_t material_of(std::size_t i) const { return kind_material[kind[i]]; }
+  Real volume_of(std::size_t i) const { return kind_volume[kind[i]]; }
+  /// The kind of material `mat` and rest volume `vol`, added when new (at most 65,536).
+  std::uint16_t kind_of(std::uint16_t mat, Real vol);
   bool has_plastic() const { return keep_plastic; }
   bool keep_plastic = false;  ///< allocate `plastic` (set when any material is plastic)
 
@@ -28,8 +38,7 @@ struct ParticleSet {
     v.push_back(vel);
     C.push_back(Mat3::Zero());
     F.push_back(Mat3::Identity());
-    volume.push_back(vol);
-    material.push_back(mat);
+    kind.push_back(kind_of(mat, vol));
     id.push_back(next_id++);
     if (keep_plastic) plastic.push_back(plastic0);
   }

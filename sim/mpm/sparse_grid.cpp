@@ -17,6 +17,22 @@ void SparseGrid::setup(double dx, const Vec3d& origin) {
 }
 
 void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs, bool serial) {
+  bin_points(first, xs, serial, keep_order);
+  bin_grid_blocks(serial);
+}
+
+void SparseGrid::bin_for_sort(const std::vector<Vec3>& x, bool serial) {
+  // The nodes go first: the order takes their place.
+  std::vector<std::array<GridNode, kBlockNodes>>().swap(gblock_nodes);
+  gblock_key.clear();
+  gblock_src.clear();
+  pblock_nbr.clear();
+  ghash_.clear();
+  bin_points(nullptr, x, serial, true);
+}
+
+void SparseGrid::bin_points(const std::vector<Vec3>* first, const std::vector<Vec3>& xs,
+                            bool serial, bool with_order) {
   const std::size_t n0 = first ? first->size() : 0;
   const std::size_t n = n0 + xs.size();
   auto pos = [&](std::size_t p) -> const Vec3& { return p < n0 ? (*first)[p] : xs[p - n0]; };
@@ -31,14 +47,7 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
         runs.clear();
         const std::size_t e = std::min(n, (c + 1) * kBinChunk);
         for (std::size_t p = c * kBinChunk; p < e; ++p) {
-          const Vec3 g = grid_coord(pos(p));
-          const int bx = static_cast<int>(std::floor(g[0] - Real(0.5))) >> 2;
-          const int by = static_cast<int>(std::floor(g[1] - Real(0.5))) >> 2;
-          const int bz = static_cast<int>(std::floor(g[2] - Real(0.5))) >> 2;
-          SHELLMPM_CHECK(
-              bx >= 0 && by >= 0 && bz >= 0 && bx < (1 << 19) && by < (1 << 19) && bz < (1 << 19),
-              << "particle " << p << " at " << pos(p).transpose() << " is off the grid");
-          const std::uint64_t key = pack_block(bx, by, bz);
+          const std::uint64_t key = block_key(grid_coord(pos(p)));
           if (runs.empty() || runs.back().key != key)
             runs.push_back({key, static_cast<std::uint32_t>(p), 0});
         }
@@ -61,33 +70,57 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
                                                           : std::min(n, (c + 1) * kBinChunk));
   };
   pblock_start.assign(nb + 1, 0);
+  block_run_start.assign(nb + 1, 0);
   for (std::size_t c = 0; c < nc; ++c)
-    for (std::size_t i = 0; i < chunk_runs_[c].size(); ++i)
-      pblock_start[chunk_runs_[c][i].block + 1] += run_end(c, i) - chunk_runs_[c][i].begin;
-  for (std::size_t b = 0; b < nb; ++b) pblock_start[b + 1] += pblock_start[b];
+    for (std::size_t i = 0; i < chunk_runs_[c].size(); ++i) {
+      const std::uint32_t b = chunk_runs_[c][i].block;
+      pblock_start[b + 1] += run_end(c, i) - chunk_runs_[c][i].begin;
+      ++block_run_start[b + 1];
+    }
+  for (std::size_t b = 0; b < nb; ++b) {
+    pblock_start[b + 1] += pblock_start[b];
+    block_run_start[b + 1] += block_run_start[b];
+  }
+  // Each block's runs in point order; from here a Run's `block` is its first slot in
+  // order().
+  block_runs.resize(block_run_start[nb]);
   std::vector<std::uint32_t> cursor(pblock_start.begin(), pblock_start.end() - 1);
+  std::vector<std::uint32_t> run_cursor(block_run_start.begin(), block_run_start.end() - 1);
   for (std::size_t c = 0; c < nc; ++c)
     for (std::size_t i = 0; i < chunk_runs_[c].size(); ++i) {
       Run& r = chunk_runs_[c][i];
       const std::uint32_t len = run_end(c, i) - r.begin;
+      block_runs[run_cursor[r.block]++] = {r.begin, len};
       const std::uint32_t slot = cursor[r.block];
       cursor[r.block] += len;
-      r.block = slot;  // from here: the run's first slot in order[]
+      r.block = slot;
     }
-  order.resize(n);
+  num_points_ = n;
+  if (with_order)
+    order_.resize(n);
+  else
+    std::vector<std::uint32_t>().swap(order_);
   parallel_for_each(
       nc, 1,
       [&](std::size_t c) {
-        for (std::size_t i = 0; i < chunk_runs_[c].size(); ++i) {
-          const Run& r = chunk_runs_[c][i];
-          const std::uint32_t len = run_end(c, i) - r.begin;
-          for (std::uint32_t t = 0; t < len; ++t) order[r.block + t] = r.begin + t;
-        }
+        if (with_order)
+          for (std::size_t i = 0; i < chunk_runs_[c].size(); ++i) {
+            const Run& r = chunk_runs_[c][i];
+            const std::uint32_t len = run_end(c, i) - r.begin;
+            for (std::uint32_t t = 0; t < len; ++t) order_[r.block + t] = r.begin + t;
+          }
         // Unsorted points (a fill before the first reorder) make many runs: not kept.
         std::vector<Run>& runs = chunk_runs_[c];
         if (runs.capacity() > 2 * runs.size() + 64) std::vector<Run>(runs).swap(runs);
       },
       serial);
+  // Unsorted points make many block runs too.
+  if (block_runs.capacity() > 2 * block_runs.size() + 64)
+    std::vector<std::array<std::uint32_t, 2>>(block_runs).swap(block_runs);
+}
+
+void SparseGrid::bin_grid_blocks(bool serial) {
+  const std::size_t nb = pblock_key.size();
   // Grid blocks: every particle block and its +1 neighbours.
   ghash_.clear();
   gblock_key.clear();
@@ -110,7 +143,28 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
       gblock_src[g][o] = (sx < 0 || sy < 0 || sz < 0) ? -1 : phash_.find(pack_block(sx, sy, sz));
     }
   }
-  pblock_buf.resize(nb);
+  if (!pblock_buf.empty()) pblock_buf.resize(nb);
+  // Columns: blocks sorted by (colour, x, y, z).
+  column_blocks.resize(nb);
+  for (std::size_t b = 0; b < nb; ++b) column_blocks[b] = static_cast<std::uint32_t>(b);
+  auto column_key = [&](std::uint32_t b) {
+    const Vec3i c = unpack_block(pblock_key[b]);
+    return std::array<int, 4>{((c[0] & 1) << 1) | (c[1] & 1), c[0], c[1], c[2]};
+  };
+  std::sort(column_blocks.begin(), column_blocks.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return column_key(a) < column_key(b); });
+  column_start.clear();
+  colour_columns.fill(0);
+  for (std::size_t i = 0; i < nb; ++i) {
+    const auto k = column_key(column_blocks[i]);
+    if (i == 0 || k[1] != column_key(column_blocks[i - 1])[1] ||
+        k[2] != column_key(column_blocks[i - 1])[2]) {
+      column_start.push_back(static_cast<std::uint32_t>(i));
+      ++colour_columns[k[0] + 1];
+    }
+  }
+  column_start.push_back(static_cast<std::uint32_t>(nb));
+  for (int c = 0; c < 4; ++c) colour_columns[c + 1] += colour_columns[c];
   gblock_nodes.resize(ng);
   parallel_for(
       ng, 64,
@@ -121,7 +175,51 @@ void SparseGrid::bin(const std::vector<Vec3>* first, const std::vector<Vec3>& xs
       serial);
 }
 
+void SparseGrid::for_each_block_by_colour(const std::function<void(std::size_t)>& f, bool serial) {
+  for (int c = 0; c < 4; ++c) {
+    const std::uint32_t c0 = colour_columns[c];
+    parallel_for_each(
+        colour_columns[c + 1] - c0, 1,
+        [&](std::size_t i) {
+          for (std::uint32_t k = column_start[c0 + i]; k < column_start[c0 + i + 1]; ++k)
+            f(column_blocks[k]);
+        },
+        serial);
+  }
+}
+
+void SparseGrid::add_pad_to_grid(std::size_t b, const GridNode* pad) {
+  for (int o = 0; o < 8; ++o) {
+    auto& nodes = gblock_nodes[pblock_nbr[b][o]];
+    const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
+    const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
+    for (int i = 0; i < ix1; ++i)
+      for (int j = 0; j < iy1; ++j)
+        for (int k = 0; k < iz1; ++k) {
+          const GridNode& from = pad[pad_node(i + ox, j + oy, k + oz)];
+          GridNode& d = nodes[block_node(i, j, k)];
+          d.m += from.m;
+          d.v[0] += from.v[0];
+          d.v[1] += from.v[1];
+          d.v[2] += from.v[2];
+        }
+  }
+}
+
+void SparseGrid::copy_grid_to_pad(std::size_t b, GridNode* pad) const {
+  for (int o = 0; o < 8; ++o) {
+    const auto& nodes = gblock_nodes[pblock_nbr[b][o]];
+    const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
+    const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
+    for (int i = 0; i < ix1; ++i)
+      for (int j = 0; j < iy1; ++j)
+        for (int k = 0; k < iz1; ++k)
+          pad[pad_node(i + ox, j + oy, k + oz)] = nodes[block_node(i, j, k)];
+  }
+}
+
 void SparseGrid::gather(bool with_mass, bool serial) {
+  SHELLMPM_CHECK(pblock_buf.size() == pblock_key.size(), << "gather before ensure_buffers");
   parallel_for_each(
       gblock_key.size(), 4,
       [&](std::size_t g) {
@@ -139,20 +237,9 @@ void SparseGrid::gather(bool with_mass, bool serial) {
 }
 
 void SparseGrid::scatter_grid_to_buffers(bool serial) {
+  ensure_buffers();
   parallel_for_each(
-      pblock_key.size(), 4,
-      [&](std::size_t b) {
-        auto& buf = pblock_buf[b];
-        for (int o = 0; o < 8; ++o) {
-          const auto& nodes = gblock_nodes[pblock_nbr[b][o]];
-          const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
-          const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
-          for (int i = 0; i < ix1; ++i)
-            for (int j = 0; j < iy1; ++j)
-              for (int k = 0; k < iz1; ++k)
-                buf[pad_node(i + ox, j + oy, k + oz)] = nodes[block_node(i, j, k)];
-        }
-      },
+      pblock_key.size(), 4, [&](std::size_t b) { copy_grid_to_pad(b, pblock_buf[b].data()); },
       serial);
 }
 
@@ -163,11 +250,12 @@ std::size_t SparseGrid::runs_bytes() const {
 }
 
 std::size_t SparseGrid::bytes() const {
-  return order.capacity() * 4 + pblock_start.capacity() * 4 + pblock_key.capacity() * 8 +
-         pblock_nbr.capacity() * 32 + pblock_buf.capacity() * sizeof(pblock_buf[0]) +
-         gblock_key.capacity() * 8 + gblock_src.capacity() * 32 +
-         gblock_nodes.capacity() * sizeof(gblock_nodes[0]) + phash_.bytes() + ghash_.bytes() +
-         runs_bytes();
+  return order_.capacity() * 4 + pblock_start.capacity() * 4 + pblock_key.capacity() * 8 +
+         block_run_start.capacity() * 4 + block_runs.capacity() * 8 + pblock_nbr.capacity() * 32 +
+         pblock_buf.capacity() * sizeof(pblock_buf[0]) +
+         (column_blocks.capacity() + column_start.capacity()) * 4 + gblock_key.capacity() * 8 +
+         gblock_src.capacity() * 32 + gblock_nodes.capacity() * sizeof(gblock_nodes[0]) +
+         phash_.bytes() + ghash_.bytes() + runs_bytes();
 }
 
 }  // namespace shellmpm

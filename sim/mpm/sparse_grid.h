@@ -1,15 +1,25 @@
 // A sparse grid of 4x4x4-node blocks that exist only around particles.
 //
 // Determinism without atomics (house style 7): particles are binned by the block of
-// their lowest stencil node ("particle block"). Each particle block scatters into its
-// own padded 6x6x6 node buffer; each grid block then sums the buffers of the (at most
-// eight) particle blocks that overlap it, always in the same order. No sum depends
-// on how threads are scheduled, so results are bit-identical for any thread count.
+// their lowest stencil node ("particle block"), whose stencils cover a padded 6x6x6 node
+// region. Two ways to sum the blocks into the grid, neither depending on how threads are
+// scheduled, so results are bit-identical for any thread count:
+// - by colour (the bulk transfers): columns of particle blocks along z whose x and y
+//   have the same parities are two blocks apart and their regions do not overlap; the
+//   four colours run one after the other, the columns of one colour in parallel, each
+//   block of a column in turn scattering into a thread's own padded buffer and adding it
+//   straight into the grid blocks;
+// - through kept buffers (points of several kinds sharing a block's buffer: shells): each
+//   particle block scatters into its own padded buffer (pblock_buf, allocated by
+//   ensure_buffers), and each grid block sums the buffers of the (at most eight) particle
+//   blocks that overlap it, always in the same order.
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
+#include "sim/core/check.h"
 #include "sim/core/types.h"
 #include "sim/mpm/block_hash.h"
 
@@ -55,6 +65,17 @@ class SparseGrid {
                 static_cast<Real>((p[1] - origin_[1]) * inv_dx_),
                 static_cast<Real>((p[2] - origin_[2]) * inv_dx_));
   }
+  /// Packed key of the particle block of a point at grid coordinates g (the block of its
+  /// lowest stencil node); throws for a point off the grid.
+  std::uint64_t block_key(const Vec3& g) const {
+    const int bx = static_cast<int>(std::floor(g[0] - Real(0.5))) >> 2;
+    const int by = static_cast<int>(std::floor(g[1] - Real(0.5))) >> 2;
+    const int bz = static_cast<int>(std::floor(g[2] - Real(0.5))) >> 2;
+    SHELLMPM_CHECK(
+        bx >= 0 && by >= 0 && bz >= 0 && bx < (1 << 19) && by < (1 << 19) && bz < (1 << 19),
+        << "a point at grid coordinates " << g.transpose() << " is off the grid");
+    return pack_block(bx, by, bz);
+  }
   /// World position of a node.
   Vec3d node_position(const Vec3i& n) const { return origin_ + dx_ * n.cast<double>(); }
 
@@ -63,12 +84,39 @@ class SparseGrid {
   /// Bytes held by the grid's arrays.
   std::size_t bytes() const;
 
+  /// Whether bin() fills order(): off where only the bulk transfers and the collider
+  /// reach read the binning (they walk block_runs), saving 4 bytes per point.
+  bool keep_order = true;
+  /// Point indices sorted by particle block (kept only with keep_order).
+  const std::vector<std::uint32_t>& order() const {
+    SHELLMPM_CHECK(order_.size() == num_points_, << "the grid was binned without its order");
+    return order_;
+  }
+  /// Bins x and fills order() only, for sorting the points by block: no grid blocks
+  /// (num_grid_blocks() is 0 until the next bin, their nodes are freed).
+  void bin_for_sort(const std::vector<Vec3>& x, bool serial = false);
+  /// Frees order() when keep_order is off (after bin_for_sort).
+  void release_order() {
+    if (!keep_order) std::vector<std::uint32_t>().swap(order_);
+  }
+
   // Particle blocks (binned particles).
-  std::vector<std::uint32_t> order;            ///< particle indices sorted by particle block
-  std::vector<std::uint32_t> pblock_start;     ///< order[pblock_start[b] .. pblock_start[b+1])
+  std::vector<std::uint32_t> pblock_start;  ///< order()[pblock_start[b] .. pblock_start[b+1])
+  /// Block b's points as runs of consecutive indices in ascending order (the order of
+  /// its slice of order()): block_runs[block_run_start[b] .. block_run_start[b+1]), each
+  /// {first index, count}.
+  std::vector<std::uint32_t> block_run_start;
+  std::vector<std::array<std::uint32_t, 2>> block_runs;
   std::vector<std::uint64_t> pblock_key;       ///< packed block coordinate
   std::vector<std::array<int, 8>> pblock_nbr;  ///< grid block at key + (ox,oy,oz), o = 4ox+2oy+oz
-  std::vector<std::array<GridNode, kPadNodes>> pblock_buf;  ///< scatter/gather buffers
+  /// Scatter/gather buffers, one per particle block: empty until ensure_buffers(), then
+  /// kept sized by bin().
+  std::vector<std::array<GridNode, kPadNodes>> pblock_buf;
+  /// Particle blocks in columns along z (same x and y), each column ascending in z; the
+  /// columns grouped by colour (x&1)<<1 | (y&1): column i is column_blocks[column_start[i]
+  /// .. column_start[i+1]), the columns of colour c are colour_columns[c] .. [c+1].
+  std::vector<std::uint32_t> column_blocks, column_start;
+  std::array<std::uint32_t, 5> colour_columns{};
   // Grid blocks.
   std::vector<std::uint64_t> gblock_key;
   std::vector<std::array<int, 8>> gblock_src;  ///< particle block at key - o, or -1
@@ -86,6 +134,13 @@ class SparseGrid {
           GridNode& nd = nodes[block_node(i, j, k)];
           if (nd.m > 0) f(nd, Vec3i(c[0] + i, c[1] + j, c[2] + k));
         }
+  }
+
+  /// Calls f(i) for every point i of particle block b, ascending.
+  template <class F>
+  void for_each_point(std::size_t b, F&& f) const {
+    for (std::uint32_t r = block_run_start[b]; r < block_run_start[b + 1]; ++r)
+      for (std::uint32_t i = block_runs[r][0], e = i + block_runs[r][1]; i < e; ++i) f(i);
   }
 
   /// Index of the grid block with packed key `key`, or -1.
@@ -107,6 +162,19 @@ class SparseGrid {
     }
   }
 
+  /// Allocates pblock_buf for the current particle blocks.
+  void ensure_buffers() {
+    if (pblock_buf.size() != pblock_key.size()) pblock_buf.resize(pblock_key.size());
+  }
+  /// Calls f(b) for every particle block b: colour by colour, the columns of one colour in
+  /// parallel, the blocks of a column in z order (columns of one colour cover disjoint
+  /// nodes, so each block may add to the grid directly).
+  void for_each_block_by_colour(const std::function<void(std::size_t)>& f, bool serial = false);
+  /// Adds a padded buffer of particle block b into the grid nodes it overlaps.
+  void add_pad_to_grid(std::size_t b, const GridNode* pad);
+  /// Copies the grid nodes that particle block b's padded region overlaps into pad.
+  void copy_grid_to_pad(std::size_t b, GridNode* pad) const;
+
   /// Sums every particle block's buffer into the grid blocks (fixed order).
   void gather_buffers_to_grid(bool serial = false) { gather(true, serial); }
   /// Adds every particle block buffer's v into the grid nodes' v (fixed order); the
@@ -117,6 +185,11 @@ class SparseGrid {
 
  private:
   void gather(bool with_mass, bool serial);
+  void bin_points(const std::vector<Vec3>* first, const std::vector<Vec3>& x, bool serial,
+                  bool with_order);
+  void bin_grid_blocks(bool serial);
+  std::vector<std::uint32_t> order_;
+  std::size_t num_points_ = 0;
   double dx_ = 1.0, inv_dx_ = 1.0;
   Vec3d origin_{0, 0, 0};
   BlockHash phash_, ghash_;

@@ -1,6 +1,7 @@
 #include "sim/mpm/transfer.h"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <type_traits>
 
@@ -11,34 +12,33 @@
 namespace shellmpm {
 namespace {
 
-using transfer_blocks::bulk_begin;
+using transfer_blocks::for_each_bulk;
 
 // Kirchhoff stresses of one particle block, in block order, computed in SIMD batches
 // over runs of particles that share a material.
 void block_stresses(const ParticleSet& p, const SparseGrid& grid, const TransferParams& tp,
                     std::size_t b, std::vector<Mat3>& F, std::vector<Real>& pl,
-                    std::vector<Mat3>& tau) {
-  const std::uint32_t s0 = bulk_begin(grid, tp, b), s1 = grid.pblock_start[b + 1];
-  const std::size_t n = s1 - s0;
-  const std::uint32_t off = tp.first_bulk;
-  F.resize(n);
-  pl.resize(n);
-  tau.resize(n);
+                    std::vector<std::uint16_t>& mat_of, std::vector<Mat3>& tau) {
+  F.clear();
+  pl.clear();
+  mat_of.clear();
   const bool plastic = p.has_plastic();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t q = grid.order[s0 + i] - off;
-    F[i] = p.F[q];
-    pl[i] = plastic ? p.plastic[q] : Real(0);
-  }
+  for_each_bulk(grid, tp, b, [&](std::uint32_t q, std::uint32_t) {
+    F.push_back(p.F[q]);
+    pl.push_back(plastic ? p.plastic[q] : Real(0));
+    mat_of.push_back(p.material_of(q));
+  });
+  const std::size_t n = F.size();
+  tau.resize(n);
   if (!tp.stress) {
     std::fill(tau.begin(), tau.end(), Mat3::Zero());
     return;
   }
   std::size_t i = 0;
   while (i < n) {
-    const auto mat = p.material[grid.order[s0 + i] - off];
+    const auto mat = mat_of[i];
     std::size_t j = i + 1;
-    while (j < n && p.material[grid.order[s0 + j] - off] == mat) ++j;
+    while (j < n && mat_of[j] == mat) ++j;
     (*tp.models)[mat].kirchhoff_batch(F.data() + i, plastic ? pl.data() + i : nullptr,
                                       tau.data() + i, j - i);
     i = j;
@@ -46,58 +46,101 @@ void block_stresses(const ParticleSet& p, const SparseGrid& grid, const Transfer
 }
 
 template <bool kMls>
-void p2g_block(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp, std::size_t b) {
+void p2g_block(const ParticleSet& p, const SparseGrid& grid, const TransferParams& tp,
+               std::size_t b, GridNode* buf) {
   thread_local std::vector<Mat3> F_local, tau_local;
   thread_local std::vector<Real> pl_local;
-  block_stresses(p, grid, tp, b, F_local, pl_local, tau_local);
+  thread_local std::vector<std::uint16_t> mat_local;
+  block_stresses(p, grid, tp, b, F_local, pl_local, mat_local, tau_local);
   const SimdLevel level = simd_level();
   if (level == SimdLevel::Avx512)
-    transfer_blocks::p2g_avx512(kMls, p, grid, tp, b, tau_local.data());
+    transfer_blocks::p2g_avx512(kMls, p, grid, tp, b, tau_local.data(), buf);
   else if (level == SimdLevel::Avx2)
-    transfer_blocks::p2g_avx2(kMls, p, grid, tp, b, tau_local.data());
+    transfer_blocks::p2g_avx2(kMls, p, grid, tp, b, tau_local.data(), buf);
   else
-    transfer_blocks::p2g<kMls>(p, grid, tp, b, tau_local.data());
+    transfer_blocks::p2g<kMls>(p, grid, tp, b, tau_local.data(), buf);
 }
 
 template <bool kMls>
-void g2p_block(ParticleSet& p, SparseGrid& grid, const TransferParams& tp, std::size_t b) {
+void g2p_block(ParticleSet& p, const SparseGrid& grid, const TransferParams& tp, std::size_t b,
+               const GridNode* buf) {
   const SimdLevel level = simd_level();
   if (level == SimdLevel::Avx512)
-    transfer_blocks::g2p_avx512(kMls, p, grid, tp, b);
+    transfer_blocks::g2p_avx512(kMls, p, grid, tp, b, buf);
   else if (level == SimdLevel::Avx2)
-    transfer_blocks::g2p_avx2(kMls, p, grid, tp, b);
+    transfer_blocks::g2p_avx2(kMls, p, grid, tp, b, buf);
   else
-    transfer_blocks::g2p<kMls>(p, grid, tp, b);
+    transfer_blocks::g2p<kMls>(p, grid, tp, b, buf);
 }
 
-/// For every particle block b in parallel: block(b, kMls) with the scheme's flag (APIC or
-/// MLS), then tp.others on the block's buffer.
+/// block(b, buf, kMls) with the scheme's flag (APIC or MLS) as a type.
 template <class Block>
-void each_particle_block(SparseGrid& grid, const TransferParams& tp, Block&& block) {
-  parallel_for_each(
-      grid.num_particle_blocks(), 1,
-      [&](std::size_t b) {
-        if (tp.mls)
-          block(b, std::true_type());
-        else
-          block(b, std::false_type());
-        if (tp.others) tp.others(b, grid.pblock_buf[b].data());
-      },
-      tp.serial);
+void with_scheme(const TransferParams& tp, std::size_t b, GridNode* buf, Block&& block) {
+  if (tp.mls)
+    block(b, buf, std::true_type());
+  else
+    block(b, buf, std::false_type());
+}
+
+/// A thread's padded buffer for the bulk-only transfers (no buffer per block is kept).
+GridNode* thread_pad() {
+  alignas(64) thread_local std::array<GridNode, kPadNodes> pad;
+  return pad.data();
 }
 
 }  // namespace
 
 void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp) {
-  each_particle_block(
-      grid, tp, [&](std::size_t b, auto mls) { p2g_block<decltype(mls)::value>(p, grid, tp, b); });
+  auto block = [&](std::size_t b, GridNode* buf, auto mls) {
+    p2g_block<decltype(mls)::value>(p, grid, tp, b, buf);
+  };
+  if (!tp.others) {
+    // Bulk particles only: colour by colour, each block straight into the grid.
+    grid.for_each_block_by_colour(
+        [&](std::size_t b) {
+          GridNode* pad = thread_pad();
+          with_scheme(tp, b, pad, block);
+          grid.add_pad_to_grid(b, pad);
+        },
+        tp.serial);
+    return;
+  }
+  grid.ensure_buffers();
+  parallel_for_each(
+      grid.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        GridNode* buf = grid.pblock_buf[b].data();
+        with_scheme(tp, b, buf, block);
+        tp.others(b, buf);
+      },
+      tp.serial);
   grid.gather_buffers_to_grid(tp.serial);
 }
 
 void grid_to_particles(ParticleSet& p, SparseGrid& grid, const TransferParams& tp) {
+  auto block = [&](std::size_t b, GridNode* buf, auto mls) {
+    g2p_block<decltype(mls)::value>(p, grid, tp, b, buf);
+  };
+  if (!tp.others) {
+    parallel_for_each(
+        grid.num_particle_blocks(), 1,
+        [&](std::size_t b) {
+          GridNode* pad = thread_pad();
+          grid.copy_grid_to_pad(b, pad);
+          with_scheme(tp, b, pad, block);
+        },
+        tp.serial);
+    return;
+  }
   grid.scatter_grid_to_buffers(tp.serial);
-  each_particle_block(
-      grid, tp, [&](std::size_t b, auto mls) { g2p_block<decltype(mls)::value>(p, grid, tp, b); });
+  parallel_for_each(
+      grid.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        GridNode* buf = grid.pblock_buf[b].data();
+        with_scheme(tp, b, buf, block);
+        tp.others(b, buf);
+      },
+      tp.serial);
 }
 
 }  // namespace shellmpm

@@ -192,13 +192,17 @@ double limit_mesh_bytes(double nv, double nt, double support, bool uvs) {
   return nv * row + 12 * nt + (uvs ? 16 * nv : 0);
 }
 
-/// Grid arrays (SparseGrid) for `points` binned into pblocks / gblocks: the sort order and
-/// block of each point, per particle block its 6^3 buffer, key, neighbours and start, per
-/// grid block its 4^3 nodes, key and sources; both hash tables at load <= 1/2.
-double grid_bytes(double points, double pblocks, double gblocks) {
+/// Grid arrays (SparseGrid) for `points` binned into pblocks / gblocks: per particle block
+/// its key, neighbours, start, column place and runs of points (a few, 24 bytes each with
+/// the binning's; the sources fill block by block), per grid
+/// block its 4^3 nodes, key and sources; both hash tables at load <= 1/2. `shells`: points
+/// other than bulk particles share the blocks, which then keep a 6^3 buffer each; `order`:
+/// the grid keeps the sort order (4 bytes a point: shells or the implicit solve).
+double grid_bytes(double points, double pblocks, double gblocks, bool shells, bool order) {
   constexpr double kNode = 4 * R;  // GridNode: m, v[3]
   const double hash = 16 * 3;      // 12 + 4 bytes a slot, 2 to 4 slots an entry
-  return 8 * points + pblocks * (216 * kNode + 8 + 32 + 4 + hash) +
+  return (order ? 4 : 0) * points +
+         pblocks * ((shells ? 216 * kNode : 0) + 8 + 32 + 4 + 8 + 4 * 24 + hash) +
          gblocks * (64 * kNode + 8 + 32 + hash);
 }
 
@@ -332,7 +336,8 @@ double fields_memory(const Scene& scene, const ShellTotals& t, const MemoryCount
   if (!fields) return fields_bytes;
   for (double pb : t.shell_pblocks) {
     const double gb = 2.2 * pb;
-    fields_bytes += grid_bytes(0, pb, gb) + pb * 216 * 14 * R + gb * 64 * (14 * R + kVec3);
+    fields_bytes +=
+        grid_bytes(0, pb, gb, false, true) + pb * 216 * 14 * R + gb * 64 * (14 * R + kVec3);
   }
   fields_bytes += 24 * n.shell_points + n.particle_blocks * 216 * 4 * R +
                   n.grid_blocks * (64 * kVec3 + 64 * 4 * R + 4 * grid_shells + 1);
@@ -347,7 +352,7 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   bool plastic = false;
   for (const MaterialDesc& m : scene.materials)
     plastic = plastic || m.kind != MaterialKind::Elastic;
-  const double per_particle = 2 * kVec3 + 2 * kMat3 + R + 2 + 4 + (plastic ? R : 0);
+  const double per_particle = 2 * kVec3 + 2 * kMat3 + 2 + 4 + (plastic ? R : 0);
   out.bytes_per_particle = per_particle;
   add_bulk_counts(scene, n);
   ShellTotals t;
@@ -356,8 +361,9 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
 
   // The particles at the peak, and the combined grid.
   const double particles = per_particle * n.peak_particles();
-  const double grid =
-      grid_bytes(n.peak_particles() + t.grid_points, n.particle_blocks, n.grid_blocks);
+  const double grid = grid_bytes(
+      n.peak_particles() + t.grid_points, n.particle_blocks, n.grid_blocks, t.grid_shells > 0,
+      t.grid_shells > 0 || scene.shot.integrator == Integrator::Implicit);
   // The integrity monitor records a side per particle and limit vertex once shells are on
   // the grid.
   double integrity_bytes = t.integrity_bytes;
@@ -371,9 +377,10 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
   for (const MemoryPart& p : out.parts) held += p.bytes;
   // A step: an emitting run copies one particle attribute (a Mat3) when its arrays double.
   const double growth = n.emitted_particles > 0 ? kMat3 * n.peak_particles() : 0;
-  // After each frame the particles are sorted by block, one 4-byte word of every attribute
-  // at a time through a scratch word per particle (sim/mpm/particles.cpp).
-  const double permute = 4.0 * n.peak_particles();
+  // After each frame the particles are sorted by block in place, with a bit per particle
+  // (sim/mpm/particles.cpp), through the sort order (4 bytes each, the grid's nodes freed
+  // meanwhile).
+  const double permute = 4.125 * n.peak_particles();
   // Contact and integrity scratch of a step (measured: about 200 bytes per contact site).
   const double contact_scratch = 200 * n.contact_sites;
   // The implicit grid solve (sim/implicit/grid_step.cpp): about 17 double vectors of 3 per

@@ -35,6 +35,9 @@ Solver::Solver(const Scene& scene, SolverOptions opt) {
   }
   c_.shell_forces.resize(c_.shells.size());
   setup_contact();
+  // The point order is read by the shells' transfers and the implicit solve; the bulk
+  // transfers and the collider reach walk the blocks' runs.
+  c_.grid.keep_order = !c_.grid_shells.empty() || s.integrator == Integrator::Implicit;
   integrity_.setup(integrity_view(), s.dx);
   if (opt.fill_sources) {
     // Every source's points first, so the particle arrays are allocated once, exactly.
@@ -43,6 +46,18 @@ Solver::Solver(const Scene& scene, SolverOptions opt) {
     for (std::size_t i = 0; i < c_.samplers.size(); ++i) {
       if (c_.scene.sources[i].emit) continue;
       c_.samplers[i].fill([&](const Vec3d& p) { pts[i].push_back(p); });
+      // By particle block: the first step's binning then finds a few runs of points per
+      // block, as after every frame's reorder, not one every few points.
+      // (A point off the grid sorts as at its edge: clamp_to_domain moves it in below.)
+      auto key = [&](const Vec3d& p) {
+        const Vec3 g = c_.grid.grid_coord(p.cast<Real>()).cwiseMax(Real(0.5)).cwiseMin(Real(1e6));
+        return c_.grid.block_key(g);
+      };
+      std::sort(pts[i].begin(), pts[i].end(), [&](const Vec3d& a, const Vec3d& b) {
+        const std::uint64_t ka = key(a), kb = key(b);
+        if (ka != kb) return ka < kb;
+        return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+      });
       total += pts[i].size();
     }
     c_.particles.reserve_more(total, true);
@@ -126,7 +141,7 @@ double Solver::stable_dt(double* vmax_out) const {
             const Real sq = c_.particles.v[p].squaredNorm();
             finite = finite && std::isfinite(sq);
             v2 = std::max(v2, sq);
-            const auto mat = c_.particles.material[p];
+            const auto mat = c_.particles.material_of(p);
             c2 = std::max(c2, c_.models[mat].wave_modulus(
                                   c_.particles.F[p],
                                   c_.particles.has_plastic() ? c_.particles.plastic[p] : Real(1)) /
@@ -186,8 +201,12 @@ double Solver::checked_stable_dt(double remaining, double* vmax) const {
 void Solver::reorder_particles() {
   // By grid block, once per frame, for memory locality.
   if (c_.particles.size() == 0) return;
+  // The sort order without grid blocks: the reorder's peak is the particles and one index
+  // each (the grid's nodes are freed), then the grid is binned again as it was.
+  c_.grid.bin_for_sort(c_.particles.x, c_.opt.serial);
+  c_.particles.permute(c_.grid.order());
+  c_.grid.release_order();
   c_.grid.bin(c_.particles.x, c_.opt.serial);
-  c_.particles.permute(c_.grid.order);
   ++c_.particle_epoch;
 }
 
@@ -282,14 +301,14 @@ void Solver::measure(FrameStats& s) const {
   };
   const Acc total = ordered_reduce(n, kParticleGrain, c_.opt.serial, Acc{}, [&](std::size_t i) {
     Acc a;
-    const auto mat = p.material[i];
-    const double m = static_cast<double>(p.volume[i]) * c_.densities[mat];
+    const auto mat = p.material_of(i);
+    const double m = static_cast<double>(p.volume_of(i)) * c_.densities[mat];
     const Vec3d v = p.v[i].cast<double>();
     a.m = m;
     a.ke = 0.5 * m * v.squaredNorm();
     a.mom = m * v;
     a.vmax = v.norm();
-    a.pe = static_cast<double>(p.volume[i]) *
+    a.pe = static_cast<double>(p.volume_of(i)) *
            c_.models[mat].energy(p.F[i], p.has_plastic() ? p.plastic[i] : Real(1));
     return a;
   });

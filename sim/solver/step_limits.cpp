@@ -117,7 +117,7 @@ std::vector<char> add_bulk(const Solver& solver, std::vector<StepLimit>& out) {
   std::vector<Real> v2(nmat, Real(0)), c2(nmat, Real(0));
   std::vector<char> present(nmat, 0), finite(nmat, 1);
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const auto mat = p.material[i];
+    const auto mat = p.material_of(i);
     present[mat] = 1;
     const Real sq = p.v[i].squaredNorm();
     if (!std::isfinite(sq)) finite[mat] = 0;

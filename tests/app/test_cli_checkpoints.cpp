@@ -86,8 +86,9 @@ std::vector<Section> sections(const std::string& b) {
            {"particle velocities", 3 * real},
            {"particle APIC matrices", 9 * real},
            {"particle deformation gradients", 9 * real},
-           {"particle volumes", real},
-           {"particle materials", 2},
+           {"particle kind materials", 2},
+           {"particle kind volumes", real},
+           {"particle kinds", 2},
            {"particle ids", 4},
            {"particle plastic state", real}})
     array(name, elem);
@@ -202,9 +203,8 @@ TEST_CASE("CLI: a damaged newest checkpoint falls back to the previous one, none
   // rerun the two runs.
   const std::vector<Section> secs = sections(read_text(runs.part + "/checkpoint.0003.bin"));
   for (const Section& sec : secs)
-    for (const char* pick :
-         {"magic", "payload size", "frame", "particle positions", "particle materials",
-          "statistics", "shell contact normals", "checksum"})
+    for (const char* pick : {"magic", "payload size", "frame", "particle positions",
+                             "particle kinds", "statistics", "shell contact normals", "checksum"})
       if (sec.name == pick) runs.expect_fallback(sec.name, sec.offset);
   runs.expect_fallback("cut in half", std::string::npos);
   {

@@ -92,8 +92,10 @@ std::vector<Writer> all_writers() {
                  VdbOptions o;
                  o.voxel_size = 0.01;
                  o.velocity = true;
-                 write_density_vdb(
-                     path, DensityInput{p.x.data(), p.v.data(), p.volume.data(), p.size()}, o);
+                 write_density_vdb(path,
+                                   DensityInput{p.x.data(), p.v.data(), p.kind_volume.data(),
+                                                p.size(), p.kind.data()},
+                                   o);
                }});
   for (MeshFormat f : {MeshFormat::Ply, MeshFormat::Obj, MeshFormat::Glb})
     w.push_back({std::string("shell mesh ") + mesh_format_extension(f),
@@ -212,20 +214,26 @@ TEST_CASE("a density VDB that fails half-way leaves the previous frame readable"
   const ParticleSet small = cloud(50, 0.05), large = cloud(40000);
   VdbOptions o;
   o.voxel_size = 0.01;
-  write_density_vdb(path, DensityInput{small.x.data(), nullptr, small.volume.data(), small.size()},
+  write_density_vdb(path,
+                    DensityInput{small.x.data(), nullptr, small.kind_volume.data(), small.size(),
+                                 small.kind.data()},
                     o);
   const DensityStats before = read_density_vdb(path);
   constexpr std::size_t kLimit = 512 * 1024;
   write_density_vdb(dir.file("unlimited.vdb"),
-                    DensityInput{large.x.data(), nullptr, large.volume.data(), large.size()}, o);
+                    DensityInput{large.x.data(), nullptr, large.kind_volume.data(), large.size(),
+                                 large.kind.data()},
+                    o);
   REQUIRE(std::filesystem::file_size(path) < kLimit);
   REQUIRE(std::filesystem::file_size(dir.file("unlimited.vdb")) > 2 * kLimit);
   {
     FileSizeLimit limit(kLimit);
     REQUIRE(limit.ok());
     CHECK_THROWS_AS(
-        write_density_vdb(
-            path, DensityInput{large.x.data(), nullptr, large.volume.data(), large.size()}, o),
+        write_density_vdb(path,
+                          DensityInput{large.x.data(), nullptr, large.kind_volume.data(),
+                                       large.size(), large.kind.data()},
+                          o),
         std::system_error);
   }
   const DensityStats after = read_density_vdb(path);

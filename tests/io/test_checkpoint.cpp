@@ -131,8 +131,9 @@ TEST_CASE("a checkpoint reads back bit for bit", "[checkpoint]") {
   CHECK(same_bits(b.particles.v, a.particles.v));
   CHECK(same_bits(b.particles.C, a.particles.C));
   CHECK(same_bits(b.particles.F, a.particles.F));
-  CHECK(same_bits(b.particles.volume, a.particles.volume));
-  CHECK(same_bits(b.particles.material, a.particles.material));
+  CHECK(same_bits(b.particles.kind_volume, a.particles.kind_volume));
+  CHECK(b.particles.kind_material == a.particles.kind_material);
+  CHECK(b.particles.kind == a.particles.kind);
   CHECK(same_bits(b.particles.id, a.particles.id));
   CHECK(same_bits(b.particles.plastic, a.particles.plastic));
   CHECK(b.stats_json == a.stats_json);
@@ -218,8 +219,13 @@ TEST_CASE("values no run writes are refused even under a valid checksum", "[chec
   }
   {
     Checkpoint b = small_checkpoint();
-    b.particles.volume[0] = 0;
-    expect_refused(dir, b, "particle volume[0]");
+    b.particles.kind_volume[0] = 0;
+    expect_refused(dir, b, "particle kind volume[0]");
+  }
+  {
+    Checkpoint b = small_checkpoint();
+    b.particles.kind[1] = 1;  // one kind only
+    expect_refused(dir, b, "particle kind[1] is 1, not below the kind count 1");
   }
   {
     Checkpoint b = small_checkpoint();
@@ -286,12 +292,12 @@ TEST_CASE("a checkpoint that does not fit its scene is refused before the solver
     damage(c);
     return user_error([&] { restore_checkpoint(solver, std::move(c), path); });
   };
-  const std::string material = refusal([](Checkpoint& c) { c.particles.material[5] = 1; });
+  const std::string material = refusal([](Checkpoint& c) { c.particles.kind_material.back() = 1; });
   CHECK(material.find(path) != std::string::npos);
-  CHECK(material.find("particle 5 has material index 1, the scene has 1 materials") !=
+  CHECK(material.find("particle kind 0 has material index 1, the scene has 1 materials") !=
         std::string::npos);
   CHECK(refusal([](Checkpoint& c) {
-          c.particles.material.back() = 65535;
+          c.particles.kind_material.back() = 65535;
         }).find("material index 65535") != std::string::npos);
   CHECK(refusal([](Checkpoint& c) {
           c.particles.keep_plastic = true;

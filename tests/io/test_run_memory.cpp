@@ -48,7 +48,7 @@ TEST_CASE("run memory: the density VDB writer's transient", "[memory_estimate]")
     so.serial = true;
     Solver solver(s, so);
     const ParticleSet& p = solver.particles();
-    DensityInput in{p.x.data(), p.v.data(), p.volume.data(), p.size()};
+    DensityInput in{p.x.data(), p.v.data(), p.kind_volume.data(), p.size(), p.kind.data()};
     VdbOptions vo;
     vo.voxel_size = s.shot.dx;
     vo.velocity = velocity;

@@ -16,9 +16,9 @@ void BulkPlasticityStage::run(StepContext& c) {
       [&](std::size_t b, std::size_t e) {
         std::size_t i = b;
         while (i < e) {
-          const auto mat = p.material[i];
+          const auto mat = p.material_of(i);
           std::size_t j = i + 1;
-          while (j < e && p.material[j] == mat) ++j;
+          while (j < e && p.material_of(j) == mat) ++j;
           const ConstitutiveModel& m = c.models[mat];
           if (m.has_plasticity()) m.project_batch(p.F.data() + i, p.plastic.data() + i, j - i);
           i = j;

@@ -69,6 +69,7 @@ struct Rig {
     GridShell& g = shells[0];
     g.force.assign(shell->size(), Vec3::Zero());
     contact->forces(shell->x.data(), g.force.data(), true);
+    grid.ensure_buffers();
     for (std::size_t b = 0; b < grid.num_particle_blocks(); ++b) {
       auto& buf = grid.pblock_buf[b];
       std::fill(buf.begin(), buf.end(), GridNode{0, {0, 0, 0}});

@@ -78,7 +78,7 @@ Totals totals(const std::vector<std::unique_ptr<ShellObject>>& sh, const Particl
     }
   if (ps)
     for (std::size_t p = 0; p < ps->size(); ++p) {
-      const double m = static_cast<double>(ps->volume[p]) * density;
+      const double m = static_cast<double>(ps->volume_of(p)) * density;
       const Vec3d v = ps->v[p].cast<double>();
       t.momentum += m * v;
       t.kinetic += 0.5 * m * v.squaredNorm();

@@ -42,7 +42,7 @@ double bulk_energy(const Solver& s) {
   double pe = 0;
   const ParticleSet& p = s.particles();
   for (std::size_t q = 0; q < p.size(); ++q)
-    pe -= static_cast<double>(p.volume[q]) * s.densities()[p.material[q]] *
+    pe -= static_cast<double>(p.volume_of(q)) * s.densities()[p.material_of(q)] *
           s.scene().shot.gravity.dot(p.x[q].cast<double>());
   return fs.kinetic_energy + fs.elastic_energy + pe;
 }

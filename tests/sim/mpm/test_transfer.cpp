@@ -66,8 +66,8 @@ TEST_CASE("P2G then G2P conserves mass, linear and angular momentum", "[transfer
     double m = 0;
     Vec3d mom = Vec3d::Zero();
     for (std::size_t i = 0; i < p.size(); ++i) {
-      m += double(p.volume[i]) * rho[0];
-      mom += double(p.volume[i]) * rho[0] * p.v[i].cast<double>();
+      m += double(p.volume_of(i)) * rho[0];
+      mom += double(p.volume_of(i)) * rho[0] * p.v[i].cast<double>();
     }
     grid.bin(p.x);
     particles_to_grid(p, grid, tp);
@@ -79,7 +79,7 @@ TEST_CASE("P2G then G2P conserves mass, linear and angular momentum", "[transfer
     // Particle linear momentum after G2P equals the grid's.
     Vec3d mom2 = Vec3d::Zero();
     for (std::size_t i = 0; i < p.size(); ++i)
-      mom2 += double(p.volume[i]) * rho[0] * p.v[i].cast<double>();
+      mom2 += double(p.volume_of(i)) * rho[0] * p.v[i].cast<double>();
     REQUIRE((mom2 - t1.p).norm() <= 1e-4 * t1.p.norm() + 1e-9);
     // A second P2G gives back the same grid angular momentum: APIC keeps it.
     grid.bin(p.x);
@@ -153,6 +153,6 @@ TEST_CASE("sparse grid allocates only blocks near particles", "[grid]") {
   REQUIRE(g.bytes() < (1u << 20));
   // Every particle is listed exactly once in block order.
   std::vector<int> seen(x.size(), 0);
-  for (auto q : g.order) seen[q]++;
+  for (auto q : g.order()) seen[q]++;
   for (int s : seen) REQUIRE(s == 1);
 }

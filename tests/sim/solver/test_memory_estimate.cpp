@@ -43,8 +43,7 @@ const std::string kHead =
 double used_bytes(const ParticleSet& p) {
   return static_cast<double>(p.x.size() * sizeof(Vec3) + p.v.size() * sizeof(Vec3) +
                              p.C.size() * sizeof(Mat3) + p.F.size() * sizeof(Mat3) +
-                             p.volume.size() * sizeof(Real) + p.material.size() * 2 +
-                             p.id.size() * 4 + p.plastic.size() * sizeof(Real));
+                             p.kind.size() * 2 + p.id.size() * 4 + p.plastic.size() * sizeof(Real));
 }
 
 double part(const SolverMemory& m, const std::string& what) {

@@ -36,8 +36,8 @@ Vec3d center_of_mass(const ParticleSet& p) {
   Vec3d c = Vec3d::Zero();
   double m = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    c += double(p.volume[i]) * p.x[i].cast<double>();
-    m += p.volume[i];
+    c += double(p.volume_of(i)) * p.x[i].cast<double>();
+    m += p.volume_of(i);
   }
   return c / m;
 }
@@ -86,7 +86,8 @@ TEST_CASE("a falling block stops on a ground plane collider", "[solver][collider
     solver.measure(fs);
     double pe = 0;
     const ParticleSet& p = solver.particles();
-    for (std::size_t i = 0; i < p.size(); ++i) pe += double(p.volume[i]) * 1000 * 9.81 * p.x[i].y();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      pe += double(p.volume_of(i)) * 1000 * 9.81 * p.x[i].y();
     return fs.kinetic_energy + fs.elastic_energy + pe;
   };
   Solver fresh(s);
@@ -94,7 +95,7 @@ TEST_CASE("a falling block stops on a ground plane collider", "[solver][collider
   fresh.measure(f0);
   double pe0 = 0;
   for (std::size_t i = 0; i < fresh.particles().size(); ++i)
-    pe0 += double(fresh.particles().volume[i]) * 1000 * 9.81 * fresh.particles().x[i].y();
+    pe0 += double(fresh.particles().volume_of(i)) * 1000 * 9.81 * fresh.particles().x[i].y();
   const double e0 = f0.kinetic_energy + pe0;
   double ymin = 1e9, emax = 0;
   for (int f = 1; f <= 36; ++f) {

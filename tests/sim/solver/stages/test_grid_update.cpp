@@ -71,6 +71,7 @@ TEST_CASE("the grid update gives a node of subnormal mass a finite velocity",
   const Vec3 v0(Real(0.3), Real(-0.2), Real(0.1));
   c.grid.bin(std::vector<Vec3>{x}, true);
   REQUIRE(c.grid.num_particle_blocks() == 1);
+  c.grid.ensure_buffers();
   auto& buf = c.grid.pblock_buf[0];
   for (GridNode& nd : buf) nd = GridNode{0, {0, 0, 0}};
   const Vec3i bc = unpack_block(c.grid.pblock_key[0]) * kBlockSize;
