@@ -71,24 +71,30 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
     n = l > 0 ? Vec3(n / l) : Vec3::Zero();
   }
   F.grid.bin(sh.x, serial);
-  const std::size_t nb = F.grid.num_particle_blocks(), ng = F.grid.num_grid_blocks();
-  F.buf.resize(nb);
+  const std::size_t ng = F.grid.num_grid_blocks();
   F.nodes.resize(ng);
   F.r.resize(ng);
   const Real dx = static_cast<Real>(F.grid.dx());
   parallel_for_each(
-      nb, 1,
+      ng, 16,
+      [&](std::size_t g) {
+        Node::clear(F.nodes[g].data(), kBlockNodes);
+        F.r[g].fill(Vec3::Zero());
+      },
+      serial);
+  // Straight into the nodes, colour by colour (blocks of a colour touch disjoint nodes):
+  // no buffer per block to clear and gather.
+  F.grid.for_each_block_by_colour(
       [&](std::size_t b) {
-        auto& buf = F.buf[b];
-        Node::clear(buf.data(), buf.size());
         const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
-        for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
-          const std::uint32_t j = F.grid.order()[q];
+        F.grid.for_each_point(b, [&](std::uint32_t j) {
           const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
           const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, folds_);
-          for_each_stencil_node(
-              W, bc, [&](const StencilNode& n) { P.add(buf[n.pad()], n.w, n.i, n.j, n.k); });
-        }
+          for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+            const auto [g, k] = F.grid.pad_to_grid(b, n.px, n.py, n.pz);
+            P.add(F.nodes[g][k], n.w, n.i, n.j, n.k);
+          });
+        });
       },
       serial);
   // Momentum to velocity, first moment to centroid offset: right after the sums, or,
@@ -100,19 +106,13 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
         d.o[a] /= d.m;
       }
   };
-  parallel_for_each(
-      ng, 4,
-      [&](std::size_t g) {
-        auto& nodes = F.nodes[g];
-        Node::clear(nodes.data(), nodes.size());
-        F.r[g].fill(Vec3::Zero());
-        F.grid.for_each_buffer_node(
-            g, [&](int dn, std::size_t src, int sn) { nodes[dn] += F.buf[src][sn]; });
-        if (!folds_)
-          for (Node& d : nodes) normalise(d);
-      },
-      serial);
   if (!folds_) {
+    parallel_for_each(
+        ng, 16,
+        [&](std::size_t g) {
+          for (Node& d : F.nodes[g]) normalise(d);
+        },
+        serial);
     F.fold.assign(ng, -1);
     F.folds.clear();
     return;

@@ -80,10 +80,11 @@ void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
                      const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf) {
   const auto [lo, hi] = slice(grid, b, 0, table.num_control_points());
   if (lo == hi) return;
+  const std::vector<std::uint32_t>& order = grid.order();
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
   for (std::uint32_t s = lo; s < hi; ++s) {
-    const std::uint32_t g = grid.order()[s];
+    const std::uint32_t g = order[s];
     const GridShell& gs = shells[table.shell(g)];
     const std::uint32_t j = table.local(g);
     const ShellObject& sh = *gs.shell;
@@ -100,10 +101,11 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
   const std::uint32_t nc = table.num_control_points();
   const auto [lo, hi] = slice(grid, b, 0, static_cast<std::uint32_t>(table.size()));
   if (lo == hi) return;
+  const std::vector<std::uint32_t>& order = grid.order();
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
   for (std::uint32_t s = lo; s < hi; ++s) {
-    const std::uint32_t g = grid.order()[s];
+    const std::uint32_t g = order[s];
     GridShell& gs = shells[table.shell(g)];
     const std::uint32_t j = table.local(g);
     if (g < nc) {
@@ -150,10 +152,11 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
         for (int n = 0; n < kPadNodes; ++n) mass[n] = buf[n].m;
         std::memset(static_cast<void*>(buf.data()), 0, sizeof(buf));
         if (lo == hi) return;
+        const std::vector<std::uint32_t>& order = grid.order();
         const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
         const Real dx = static_cast<Real>(grid.dx());
         for (std::uint32_t s = lo; s < hi; ++s) {
-          const std::uint32_t g = grid.order()[s];
+          const std::uint32_t g = order[s];
           const ShellContact& c = *shells[table.shell(g)].contact;
           const std::uint32_t p = table.local(g);
           const Vec3& G3 = c.G3[p];

@@ -154,11 +154,18 @@ IntegrityMonitor::Hit IntegrityMonitor::side_of(const Vec3d& x, int exclude) con
   return best;
 }
 
-void IntegrityMonitor::compare(const IntegrityView& view, bool record_only) {
-  if (shells_.empty()) return;  // nothing to cross: no side records (no memory per particle)
+bool IntegrityMonitor::compare(const IntegrityView& view, bool record_only) {
+  if (shells_.empty()) return false;  // nothing to cross: no side records (no memory per particle)
+  const std::size_t nb = view.bulk ? view.bulk->size() : 0;
+  if (shells_.size() == 1 && nb == 0) {
+    // One shell and no particles: no point can be on a side of another shell (a shell's
+    // own vertices are not judged against it), so the check is done without the limit
+    // surface (its evaluation and triangle grid were 18% of a cloth's step).
+    ++checks_;
+    return false;
+  }
   refresh(view);
   const std::size_t nv = vertex_offset_.back();
-  const std::size_t nb = view.bulk ? view.bulk->size() : 0;
   const std::size_t n = nv + nb;
   if (record_only) {
     rec_shell_.assign(n, -1);
@@ -200,6 +207,7 @@ void IntegrityMonitor::compare(const IntegrityView& view, bool record_only) {
     merge(t[0], bulk_cross_, bulk_where_, nullptr);
     merge(t[1], point_cross_, point_where_, &point_from_);
   }
+  return true;
 }
 
 void IntegrityMonitor::begin_frame(const IntegrityView& view) {
@@ -222,7 +230,7 @@ void IntegrityMonitor::track(const IntegrityView& view) {
 IntegrityReport IntegrityMonitor::end_frame(const IntegrityView& view) {
   IntegrityReport r;
   if (!active_) return r;
-  compare(view, false);
+  if (!compare(view, false)) refresh(view);  // the frame-end checks need the limit surface
   r.checks = checks_;
   for (std::size_t s = 0; s < shells_.size(); ++s) {
     if (bulk_cross_[s]) {

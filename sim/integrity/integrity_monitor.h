@@ -78,7 +78,9 @@ class IntegrityMonitor {
   /// Tracked point i: shell limit vertices first (s: the shell, advanced from its value
   /// as i grows), then the bulk particles.
   Vec3d point(const IntegrityView& view, std::size_t i, std::size_t& s) const;
-  void compare(const IntegrityView& view, bool record_only);
+  /// A side check of every point (record_only: the frame's first); false when there was
+  /// nothing to compare and the limit surface was not refreshed.
+  bool compare(const IntegrityView& view, bool record_only);
   void frame_end_checks(const IntegrityView& view, IntegrityReport& r) const;
   void check_non_finite(const IntegrityView& view, IntegrityReport& r) const;
   void check_crossings(const IntegrityView& view, IntegrityReport& r) const;

@@ -17,6 +17,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "sim/core/check.h"
@@ -170,6 +171,11 @@ class SparseGrid {
   /// parallel, the blocks of a column in z order (columns of one colour cover disjoint
   /// nodes, so each block may add to the grid directly).
   void for_each_block_by_colour(const std::function<void(std::size_t)>& f, bool serial = false);
+  /// Grid block and node index of node (px, py, pz) of particle block b's padded region.
+  std::pair<int, int> pad_to_grid(std::size_t b, int px, int py, int pz) const {
+    const int o = ((px >> 2) << 2) | ((py >> 2) << 1) | (pz >> 2);
+    return {pblock_nbr[b][o], block_node(px & 3, py & 3, pz & 3)};
+  }
   /// Adds a padded buffer of particle block b into the grid nodes it overlaps.
   void add_pad_to_grid(std::size_t b, const GridNode* pad);
   /// Copies the grid nodes that particle block b's padded region overlaps into pad.

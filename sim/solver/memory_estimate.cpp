@@ -322,7 +322,7 @@ void add_bulk_counts(const Scene& scene, MemoryCounts& n) {
 
 /// Per-shell velocity fields (shot.shell_velocities: per_shell) when two bodies share the
 /// grid (two shells, a shell and bulk, or a shell's folds): each bins its control points
-/// into its own grid and keeps 6^3 buffers and 4^3 nodes of 14 Reals; the combined grid
+/// into its own grid and keeps 4^3 nodes of 16 Reals (no buffers); the combined grid
 /// keeps the bulk moments. Fold blocks are transient and few (a crumple's folds cover a
 /// fraction of its blocks). 0 when the fields are off.
 double fields_memory(const Scene& scene, const ShellTotals& t, const MemoryCounts& n) {
@@ -336,8 +336,7 @@ double fields_memory(const Scene& scene, const ShellTotals& t, const MemoryCount
   if (!fields) return fields_bytes;
   for (double pb : t.shell_pblocks) {
     const double gb = 2.2 * pb;
-    fields_bytes +=
-        grid_bytes(0, pb, gb, false, true) + pb * 216 * 14 * R + gb * 64 * (14 * R + kVec3);
+    fields_bytes += grid_bytes(0, pb, gb, false, true) + gb * 64 * (16 * R + kVec3);
   }
   fields_bytes += 24 * n.shell_points + n.particle_blocks * 216 * 4 * R +
                   n.grid_blocks * (64 * kVec3 + 64 * 4 * R + 4 * grid_shells + 1);
