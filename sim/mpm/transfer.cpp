@@ -82,6 +82,20 @@ void with_scheme(const TransferParams& tp, std::size_t b, GridNode* buf, Block&&
     block(b, buf, std::false_type());
 }
 
+/// For every particle block b in parallel, on its kept buffer: the bulk particles
+/// (block(b, buf, kMls)), then tp.others (the shells' points of the block).
+template <class Block>
+void each_block_buffer(SparseGrid& grid, const TransferParams& tp, Block&& block) {
+  parallel_for_each(
+      grid.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        GridNode* buf = grid.pblock_buf[b].data();
+        with_scheme(tp, b, buf, block);
+        tp.others(b, buf);
+      },
+      tp.serial);
+}
+
 /// A thread's padded buffer for the bulk-only transfers (no buffer per block is kept).
 GridNode* thread_pad() {
   alignas(64) thread_local std::array<GridNode, kPadNodes> pad;
@@ -106,14 +120,7 @@ void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferPar
     return;
   }
   grid.ensure_buffers();
-  parallel_for_each(
-      grid.num_particle_blocks(), 1,
-      [&](std::size_t b) {
-        GridNode* buf = grid.pblock_buf[b].data();
-        with_scheme(tp, b, buf, block);
-        tp.others(b, buf);
-      },
-      tp.serial);
+  each_block_buffer(grid, tp, block);
   grid.gather_buffers_to_grid(tp.serial);
 }
 
@@ -133,14 +140,7 @@ void grid_to_particles(ParticleSet& p, SparseGrid& grid, const TransferParams& t
     return;
   }
   grid.scatter_grid_to_buffers(tp.serial);
-  parallel_for_each(
-      grid.num_particle_blocks(), 1,
-      [&](std::size_t b) {
-        GridNode* buf = grid.pblock_buf[b].data();
-        with_scheme(tp, b, buf, block);
-        tp.others(b, buf);
-      },
-      tp.serial);
+  each_block_buffer(grid, tp, block);
 }
 
 }  // namespace shellmpm
