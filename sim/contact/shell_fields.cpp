@@ -20,7 +20,10 @@ void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bul
   active_ = num_shells >= 2 || (num_shells >= 1 && (bulk || folds));
   if (!active_) return;
   fields_.resize(num_shells);
-  for (Field& f : fields_) f.grid.setup(grid.dx(), grid.origin());
+  for (Field& f : fields_) {
+    f.grid.setup(grid.dx(), grid.origin());
+    f.grid.keep_nodes = false;  // the field's own nodes (Field::nodes) hold its sums
+  }
 }
 
 ShellFields::PointShare::PointShare(const GridShell& gs, const Vec3& nj, const Vec3& f,

@@ -134,7 +134,7 @@ class ShellFields {
   }
   static bool is_split(const FoldBlock& fb, int bn) { return fb.split[bn] != 0; }
   struct Field {
-    SparseGrid grid;  ///< binning of this shell's control points (its nodes unused)
+    SparseGrid grid;  ///< binning of this shell's control points (no grid nodes)
     std::vector<std::array<Node, kBlockNodes>> nodes;  ///< the shell, or its first class
     std::vector<std::array<Vec3, kBlockNodes>> r;      ///< velocity relative to the node
     std::vector<Vec3> x0;                              ///< control points at p2g time

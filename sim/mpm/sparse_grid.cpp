@@ -165,6 +165,10 @@ void SparseGrid::bin_grid_blocks(bool serial) {
   }
   column_start.push_back(static_cast<std::uint32_t>(nb));
   for (int c = 0; c < 4; ++c) colour_columns[c + 1] += colour_columns[c];
+  if (!keep_nodes) {
+    std::vector<std::array<GridNode, kBlockNodes>>().swap(gblock_nodes);
+    return;
+  }
   gblock_nodes.resize(ng);
   parallel_for(
       ng, 64,

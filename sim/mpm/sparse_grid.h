@@ -85,6 +85,9 @@ class SparseGrid {
   /// Bytes held by the grid's arrays.
   std::size_t bytes() const;
 
+  /// Whether bin() allocates and zeroes the grid blocks' nodes: off for a grid that only
+  /// bins (the per-shell fields keep their own node arrays).
+  bool keep_nodes = true;
   /// Whether bin() fills order(): off where only the bulk transfers and the collider
   /// reach read the binning (they walk block_runs), saving 4 bytes per point.
   bool keep_order = true;

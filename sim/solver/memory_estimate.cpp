@@ -197,13 +197,15 @@ double limit_mesh_bytes(double nv, double nt, double support, bool uvs) {
 /// the binning's; the sources fill block by block), per grid
 /// block its 4^3 nodes, key and sources; both hash tables at load <= 1/2. `shells`: points
 /// other than bulk particles share the blocks, which then keep a 6^3 buffer each; `order`:
-/// the grid keeps the sort order (4 bytes a point: shells or the implicit solve).
-double grid_bytes(double points, double pblocks, double gblocks, bool shells, bool order) {
+/// the grid keeps the sort order (4 bytes a point: shells or the implicit solve); `nodes`:
+/// the grid blocks have nodes (not the per-shell fields' binning grids).
+double grid_bytes(double points, double pblocks, double gblocks, bool shells, bool order,
+                  bool nodes = true) {
   constexpr double kNode = 4 * R;  // GridNode: m, v[3]
   const double hash = 16 * 3;      // 12 + 4 bytes a slot, 2 to 4 slots an entry
   return (order ? 4 : 0) * points +
          pblocks * ((shells ? 216 * kNode : 0) + 8 + 32 + 4 + 8 + 4 * 24 + hash) +
-         gblocks * (64 * kNode + 8 + 32 + hash);
+         gblocks * ((nodes ? 64 * kNode : 0) + 8 + 32 + hash);
 }
 
 /// What the shells hold and build, summed over the shells (estimate_solver_memory).
@@ -336,7 +338,7 @@ double fields_memory(const Scene& scene, const ShellTotals& t, const MemoryCount
   if (!fields) return fields_bytes;
   for (double pb : t.shell_pblocks) {
     const double gb = 2.2 * pb;
-    fields_bytes += grid_bytes(0, pb, gb, false, true) + gb * 64 * (16 * R + kVec3);
+    fields_bytes += grid_bytes(0, pb, gb, false, true, false) + gb * 64 * (16 * R + kVec3);
   }
   fields_bytes += 24 * n.shell_points + n.particle_blocks * 216 * 4 * R +
                   n.grid_blocks * (64 * kVec3 + 64 * 4 * R + 4 * grid_shells + 1);
