@@ -22,28 +22,6 @@ using namespace shellmpm;
 
 namespace {
 
-Scene cube_scene(double cells_per_side, double dx, const std::string& transfer) {
-  Scene s;
-  s.path = "bench";
-  s.shot.dx = dx;
-  s.shot.domain_min = Vec3d(0, 0, 0);
-  s.shot.domain_max = Vec3d(1, 1, 1);
-  s.shot.cfl = 0.9;
-  s.shot.dt_max = 1e-4;  // fixed step: the cube is soft enough that CFL never binds
-  s.shot.transfer = transfer == "mls" ? Transfer::Mls : Transfer::Apic;
-  s.materials.push_back(shellmpm_bench::jelly());
-  SourceDesc src;
-  src.material = 0;
-  src.shape.kind = ShapeDesc::Kind::Box;
-  const double side = cells_per_side * dx;
-  src.shape.min = Vec3d(0.5 - side / 2, 0.5 - side / 2, 0.5 - side / 2);
-  src.shape.max = src.shape.min + Vec3d::Constant(side);
-  src.particles_per_cell = 8;
-  src.velocity = Vec3d(0.3, -0.5, 0.2);
-  s.sources.push_back(src);
-  return s;
-}
-
 struct Result {
   double pss = 0;  // particle-steps per second
   std::map<std::string, double> stage;
@@ -87,7 +65,8 @@ int main(int argc, char** argv) {
            {"--threads", [&](const char* v) { threads = parse_int_list(v); }}}))
     return 2;
   const double cells = std::round(std::cbrt(target / 8.0));
-  const Scene scene = cube_scene(cells, dx, transfer);
+  const Scene scene =
+      shellmpm_bench::cube_scene(cells, dx, transfer == "mls" ? Transfer::Mls : Transfer::Apic);
   std::printf(
       "mpm_throughput: elastic cube %gx%gx%g cells, 8 particles/cell, dx %g, %s, %s, %d steps\n",
       cells, cells, cells, dx, transfer.c_str(), sizeof(Real) == 4 ? "float" : "double", steps);

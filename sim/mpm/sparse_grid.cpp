@@ -193,33 +193,12 @@ void SparseGrid::for_each_block_by_colour(const std::function<void(std::size_t)>
 }
 
 void SparseGrid::add_pad_to_grid(std::size_t b, const GridNode* pad) {
-  for (int o = 0; o < 8; ++o) {
-    auto& nodes = gblock_nodes[pblock_nbr[b][o]];
-    const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
-    const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
-    for (int i = 0; i < ix1; ++i)
-      for (int j = 0; j < iy1; ++j)
-        for (int k = 0; k < iz1; ++k) {
-          const GridNode& from = pad[pad_node(i + ox, j + oy, k + oz)];
-          GridNode& d = nodes[block_node(i, j, k)];
-          d.m += from.m;
-          d.v[0] += from.v[0];
-          d.v[1] += from.v[1];
-          d.v[2] += from.v[2];
-        }
-  }
+  for_each_pad_node(b,
+                    [&](int g, int bn, int pn) { add_node(gblock_nodes[g][bn], pad[pn], true); });
 }
 
 void SparseGrid::copy_grid_to_pad(std::size_t b, GridNode* pad) const {
-  for (int o = 0; o < 8; ++o) {
-    const auto& nodes = gblock_nodes[pblock_nbr[b][o]];
-    const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
-    const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
-    for (int i = 0; i < ix1; ++i)
-      for (int j = 0; j < iy1; ++j)
-        for (int k = 0; k < iz1; ++k)
-          pad[pad_node(i + ox, j + oy, k + oz)] = nodes[block_node(i, j, k)];
-  }
+  for_each_pad_node(b, [&](int g, int bn, int pn) { pad[pn] = gblock_nodes[g][bn]; });
 }
 
 void SparseGrid::gather(bool with_mass, bool serial) {
@@ -229,12 +208,7 @@ void SparseGrid::gather(bool with_mass, bool serial) {
       [&](std::size_t g) {
         auto& nodes = gblock_nodes[g];
         for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
-          const GridNode& from = pblock_buf[src][sn];
-          GridNode& d = nodes[dn];
-          if (with_mass) d.m += from.m;
-          d.v[0] += from.v[0];
-          d.v[1] += from.v[1];
-          d.v[2] += from.v[2];
+          add_node(nodes[dn], pblock_buf[src][sn], with_mass);
         });
       },
       serial);

@@ -14,6 +14,7 @@
 //   ensure_buffers), and each grid block sums the buffers of the (at most eight) particle
 //   blocks that overlap it, always in the same order.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -140,11 +141,13 @@ class SparseGrid {
         }
   }
 
-  /// Calls f(i) for every point i of particle block b, ascending.
+  /// Calls f(i) for every point i >= first of particle block b, ascending.
   template <class F>
-  void for_each_point(std::size_t b, F&& f) const {
-    for (std::uint32_t r = block_run_start[b]; r < block_run_start[b + 1]; ++r)
-      for (std::uint32_t i = block_runs[r][0], e = i + block_runs[r][1]; i < e; ++i) f(i);
+  void for_each_point(std::size_t b, F&& f, std::uint32_t first = 0) const {
+    for (std::uint32_t r = block_run_start[b]; r < block_run_start[b + 1]; ++r) {
+      const std::uint32_t e = block_runs[r][0] + block_runs[r][1];
+      for (std::uint32_t i = std::max(block_runs[r][0], first); i < e; ++i) f(i);
+    }
   }
 
   /// Index of the grid block with packed key `key`, or -1.
@@ -194,6 +197,26 @@ class SparseGrid {
 
  private:
   void gather(bool with_mass, bool serial);
+  /// d += s (the mass too when with_mass).
+  static void add_node(GridNode& d, const GridNode& s, bool with_mass) {
+    if (with_mass) d.m += s.m;
+    d.v[0] += s.v[0];
+    d.v[1] += s.v[1];
+    d.v[2] += s.v[2];
+  }
+  /// Calls f(grid block, node in it, node of the padded region) for every node of particle
+  /// block b's padded region.
+  template <class F>
+  void for_each_pad_node(std::size_t b, F&& f) const {
+    for (int o = 0; o < 8; ++o) {
+      const int g = pblock_nbr[b][o];
+      const int ox = (o >> 2) * 4, oy = ((o >> 1) & 1) * 4, oz = (o & 1) * 4;
+      const int ix1 = ox ? 2 : 4, iy1 = oy ? 2 : 4, iz1 = oz ? 2 : 4;
+      for (int i = 0; i < ix1; ++i)
+        for (int j = 0; j < iy1; ++j)
+          for (int k = 0; k < iz1; ++k) f(g, block_node(i, j, k), pad_node(i + ox, j + oy, k + oz));
+    }
+  }
   void bin_points(const std::vector<Vec3>* first, const std::vector<Vec3>& x, bool serial,
                   bool with_order);
   void bin_grid_blocks(bool serial);

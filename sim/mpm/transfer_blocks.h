@@ -21,11 +21,8 @@ namespace shellmpm::transfer_blocks {
 template <class F>
 inline void for_each_bulk(const SparseGrid& grid, const TransferParams& tp, std::size_t b, F&& f) {
   std::uint32_t i = 0;
-  for (std::uint32_t r = grid.block_run_start[b]; r < grid.block_run_start[b + 1]; ++r) {
-    const std::uint32_t e = grid.block_runs[r][0] + grid.block_runs[r][1];
-    for (std::uint32_t g = std::max(grid.block_runs[r][0], tp.first_bulk); g < e; ++g)
-      f(g - tp.first_bulk, i++);
-  }
+  grid.for_each_point(
+      b, [&](std::uint32_t g) { f(g - tp.first_bulk, i++); }, tp.first_bulk);
 }
 
 /// Zeroes buf (block b's padded buffer, kPadNodes nodes) and scatters the block's bulk

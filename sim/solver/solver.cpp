@@ -202,7 +202,8 @@ void Solver::reorder_particles() {
   // By grid block, once per frame, for memory locality.
   if (c_.particles.size() == 0) return;
   // The sort order without grid blocks: the reorder's peak is the particles and one index
-  // each (the grid's nodes are freed), then the grid is binned again as it was.
+  // each (the grid's nodes are freed), then the grid is binned again as it was (the
+  // frame's statistics count its blocks).
   c_.grid.bin_for_sort(c_.particles.x, c_.opt.serial);
   c_.particles.permute(c_.grid.order());
   c_.grid.release_order();
