@@ -192,8 +192,8 @@ class KirchhoffLoveShellT {
 
   /// eval_point for points q0 .. q0 + n - 1 in order (energies added in that order), each
   /// point's adjoints turned into its entries' force shares (entry_shares) when fe is not
-  /// null. The float specialisation (sim/shell/kl_batch.cpp) runs four points per SSE
-  /// register.
+  /// null. The float specialisation (sim/shell/kl_batch.cpp) runs 4, 8 or 16 points per
+  /// register (SSE, AVX2, AVX-512), with the same bits on each.
   void eval_points(std::size_t q0, std::size_t n, const Vec3T* x, T* fe, double& e_total,
                    double* e_membrane) const;
   /// From point q's adjoints G (15 values), writes each of its entries' dE/dx share (3
@@ -239,7 +239,7 @@ class KirchhoffLoveShellT {
   mutable ForceScratch scratch_;
 };
 
-/// The four-lane float kernel (sim/shell/kl_batch.cpp).
+/// The batched float kernel (sim/shell/kl_batch.cpp).
 template <>
 void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, const Vec3T* x,
                                              float* fe, double& e_total, double* e_membrane) const;

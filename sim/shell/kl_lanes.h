@@ -1,14 +1,18 @@
-// Four-lane float arithmetic for the batched Kirchhoff-Love force kernel
-// (sim/shell/kl_batch.cpp): one SSE register of four quadrature points, element-wise
-// operators (GCC vector extensions), a select, square root, and a vectorised natural
-// logarithm. Internal to sim/shell.
+// Lane arithmetic for the batched Kirchhoff-Love force kernel (sim/shell/kl_batch_body.h):
+// W quadrature points in one SSE (4), AVX (8) or AVX-512 (16) register, element-wise
+// operators (GCC vector extensions), selects, square root, an any-lane test and a
+// vectorised natural logarithm. Every operation is element-wise and exactly rounded or
+// integer, so a lane's result is the same at every width. Internal to sim/shell.
 //
-// log4: x = m 2^e with m in [sqrt(1/2), sqrt(2)), log x = e log 2 + log m, log(1 + f) by the
+// log: x = m 2^e with m in [sqrt(1/2), sqrt(2)), log x = e log 2 + log m, log(1 + f) by the
 // degree-9 minimax polynomial of Cephes' logf (Moshier) and log 2 split in two parts
 // (0.693359375 exact in float, plus -2.12194440e-4): within 2 ulp of std::log on normal
 // numbers (tests/sim/shell/test_kl_batch.cpp). Zero gives -inf, negatives and NaN give
 // NaN, inf gives inf, as std::log; subnormals are read as their normal neighbours' scale
 // (a layer that thin has blown up long before).
+//
+// The 8- and 16-lane forms need the translation unit compiled for AVX2 or AVX-512: a
+// width is only instantiated where its instructions are enabled.
 #pragma once
 #include <immintrin.h>
 
@@ -17,68 +21,139 @@
 
 namespace shellmpm::kl::lanes {
 
-typedef float F4 __attribute__((vector_size(16)));
-typedef std::int32_t I4 __attribute__((vector_size(16)));
+template <int W>
+struct Width {
+  typedef float F __attribute__((vector_size(4 * W)));
+  typedef std::int32_t I __attribute__((vector_size(4 * W)));
+};
+typedef Width<4>::F F4;
+typedef Width<4>::I I4;
 
-[[gnu::always_inline]] inline F4 splat(float s) {
-  return F4{s, s, s, s};
+/// Lanes in a float vector type.
+template <class F>
+constexpr int kLanes = static_cast<int>(sizeof(F) / sizeof(float));
+
+template <class F = F4>
+[[gnu::always_inline]] inline F splat(float s) {
+  return F{} + s;
 }
-[[gnu::always_inline]] inline F4 sqrt4(F4 a) {
-  return reinterpret_cast<F4>(_mm_sqrt_ps(reinterpret_cast<__m128>(a)));
+template <class F>
+[[gnu::always_inline]] inline F vsqrt(F a) {
+  if constexpr (kLanes<F> == 4)
+    return reinterpret_cast<F>(_mm_sqrt_ps(reinterpret_cast<__m128>(a)));
+  else if constexpr (kLanes<F> == 8)
+    return reinterpret_cast<F>(_mm256_sqrt_ps(reinterpret_cast<__m256>(a)));
+  else
+    return reinterpret_cast<F>(_mm512_sqrt_ps(reinterpret_cast<__m512>(a)));
 }
 /// std::max(a, b) lane by lane (a where b < a is false, so a NaN a stays).
-[[gnu::always_inline]] inline F4 max4(F4 a, F4 b) {
+template <class F>
+[[gnu::always_inline]] inline F vmax(F a, F b) {
   return a < b ? b : a;
 }
+/// Whether any lane of a comparison result is set.
+template <class I>
+[[gnu::always_inline]] inline bool any(I m) {
+  if constexpr (sizeof(I) == 16)
+    return _mm_movemask_ps(reinterpret_cast<__m128>(m)) != 0;
+  else if constexpr (sizeof(I) == 32)
+    return _mm256_movemask_ps(reinterpret_cast<__m256>(m)) != 0;
+  else
+    return _mm512_test_epi32_mask(reinterpret_cast<__m512i>(m), reinterpret_cast<__m512i>(m)) != 0;
+}
 
-inline F4 log4(F4 x) {
-  const I4 bits = reinterpret_cast<I4>(x);
-  I4 e = ((bits >> 23) & 0xff) - 127;
-  F4 m = reinterpret_cast<F4>((bits & 0x007fffff) | 0x3f800000);  // [1, 2)
-  const I4 big = m > splat(1.41421356f);
-  m = big ? m * splat(0.5f) : m;
+template <class F>
+inline F vlog(F x) {
+  using I = decltype(x < x);
+  const I bits = reinterpret_cast<I>(x);
+  I e = ((bits >> 23) & 0xff) - 127;
+  F m = reinterpret_cast<F>((bits & 0x007fffff) | 0x3f800000);  // [1, 2)
+  const I big = m > splat<F>(1.41421356f);
+  m = big ? m * splat<F>(0.5f) : m;
   e = e - big;  // big is -1 where true
-  const F4 f = m - splat(1.0f);
-  const F4 ef = __builtin_convertvector(e, F4);
-  const F4 z = f * f;
-  F4 y = splat(7.0376836292e-2f);
-  y = y * f - splat(1.1514610310e-1f);
-  y = y * f + splat(1.1676998740e-1f);
-  y = y * f - splat(1.2420140846e-1f);
-  y = y * f + splat(1.4249322787e-1f);
-  y = y * f - splat(1.6668057665e-1f);
-  y = y * f + splat(2.0000714765e-1f);
-  y = y * f - splat(2.4999993993e-1f);
-  y = y * f + splat(3.3333331174e-1f);
+  const F f = m - splat<F>(1.0f);
+  const F ef = __builtin_convertvector(e, F);
+  const F z = f * f;
+  F y = splat<F>(7.0376836292e-2f);
+  y = y * f - splat<F>(1.1514610310e-1f);
+  y = y * f + splat<F>(1.1676998740e-1f);
+  y = y * f - splat<F>(1.2420140846e-1f);
+  y = y * f + splat<F>(1.4249322787e-1f);
+  y = y * f - splat<F>(1.6668057665e-1f);
+  y = y * f + splat<F>(2.0000714765e-1f);
+  y = y * f - splat<F>(2.4999993993e-1f);
+  y = y * f + splat<F>(3.3333331174e-1f);
   y = y * f * z;
-  y = y + splat(-2.12194440e-4f) * ef;
-  y = y - splat(0.5f) * z;
-  F4 r = f + y;
-  r = r + splat(0.693359375f) * ef;
+  y = y + splat<F>(-2.12194440e-4f) * ef;
+  y = y - splat<F>(0.5f) * z;
+  F r = f + y;
+  r = r + splat<F>(0.693359375f) * ef;
   const float inf = std::numeric_limits<float>::infinity();
-  const F4 nan = splat(std::numeric_limits<float>::quiet_NaN());
-  r = x > splat(0.0f) ? r : (x == splat(0.0f) ? splat(-inf) : nan);
-  return x == splat(inf) ? splat(inf) : r;
+  const F nan = splat<F>(std::numeric_limits<float>::quiet_NaN());
+  r = x > splat<F>(0.0f) ? r : (x == splat<F>(0.0f) ? splat<F>(-inf) : nan);
+  return x == splat<F>(inf) ? splat<F>(inf) : r;
 }
 
 /// A 3-vector of lanes.
+template <class F>
 struct V3 {
-  F4 x, y, z;
+  F x, y, z;
 };
-[[gnu::always_inline]] inline V3 operator+(const V3& a, const V3& b) {
+template <class F>
+[[gnu::always_inline]] inline V3<F> operator+(const V3<F>& a, const V3<F>& b) {
   return {a.x + b.x, a.y + b.y, a.z + b.z};
 }
-[[gnu::always_inline]] inline V3 operator-(const V3& a, const V3& b) {
+template <class F>
+[[gnu::always_inline]] inline V3<F> operator-(const V3<F>& a, const V3<F>& b) {
   return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
-[[gnu::always_inline]] inline V3 operator*(F4 s, const V3& a) {
+template <class F>
+[[gnu::always_inline]] inline V3<F> operator*(F s, const V3<F>& a) {
   return {s * a.x, s * a.y, s * a.z};
 }
-[[gnu::always_inline]] inline F4 dot(const V3& a, const V3& b) {
+template <class F>
+[[gnu::always_inline]] inline F dot(const V3<F>& a, const V3<F>& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
-[[gnu::always_inline]] inline V3 cross(const V3& a, const V3& b) {
+template <class F>
+[[gnu::always_inline]] inline V3<F> cross(const V3<F>& a, const V3<F>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+
+/// Four SSE registers of one group of four lanes each as one W-lane vector (W = 4 n).
+template <class F>
+[[gnu::always_inline]] inline F join(const __m128* p) {
+  if constexpr (kLanes<F> == 4) {
+    return reinterpret_cast<F>(p[0]);
+  } else if constexpr (kLanes<F> == 8) {
+    return reinterpret_cast<F>(_mm256_insertf128_ps(_mm256_castps128_ps256(p[0]), p[1], 1));
+  } else {
+    const __m256 lo = _mm256_insertf128_ps(_mm256_castps128_ps256(p[0]), p[1], 1);
+    const __m256 hi = _mm256_insertf128_ps(_mm256_castps128_ps256(p[2]), p[3], 1);
+    return reinterpret_cast<F>(_mm512_insertf32x8(_mm512_castps256_ps512(lo), hi, 1));
+  }
+}
+/// Lanes 4 g .. 4 g + 3 of v.
+template <class F>
+[[gnu::always_inline]] inline __m128 part(F v, int g) {
+  if constexpr (kLanes<F> == 4) {
+    return reinterpret_cast<__m128>(v);
+  } else if constexpr (kLanes<F> == 8) {
+    const __m256 r = reinterpret_cast<__m256>(v);
+    return g == 0 ? _mm256_castps256_ps128(r) : _mm256_extractf128_ps(r, 1);
+  } else {
+    const __m512 r = reinterpret_cast<__m512>(v);
+    switch (g) {
+      case 0:
+        return _mm512_castps512_ps128(r);
+      case 1:
+        return _mm512_extractf32x4_ps(r, 1);
+      case 2:
+        return _mm512_extractf32x4_ps(r, 2);
+      default:
+        return _mm512_extractf32x4_ps(r, 3);
+    }
+  }
 }
 
 }  // namespace shellmpm::kl::lanes

@@ -1,0 +1,260 @@
+// The Kirchhoff-Love energy and adjoints of W quadrature points at once, in float: the
+// same computation as KirchhoffLoveShellT::eval_kinematics (kirchhoff_love.cpp,
+// laminate_energy.h) with each point in one lane (sim/shell/kl_lanes.h). Included once by
+// each translation unit of an instruction set (kl_batch.cpp: SSE, kl_batch_avx2.cpp,
+// kl_batch_avx512.cpp) with SHELLMPM_KL_BATCH_ENTRY naming its entry point and
+// SHELLMPM_KL_BATCH_WIDTH its lanes; everything else here has internal linkage, so no
+// instruction set's copy of a helper can stand in for another's.
+//
+// The per-point gathers of a_alpha and a_alphabeta run one point at a time (a point's
+// control points vary), x, y and z in the lanes of an SSE register, then 4x4 transposes
+// put one point per lane; from there on every operation is element-wise, so a point's
+// result depends neither on its lane, nor on the width, nor on its neighbours (the same
+// bits on SSE, AVX2 and AVX-512, for any thread count). The branches of the scalar code
+// (the small-x series of atanh(x)/x, the stretch term past the limit) are taken in every
+// lane and selected.
+//
+// Differences to the scalar code, all rounding: log is vlog (within 2 ulp), atanh(x) is
+// log((1 + x) / (1 - x)) / 2, and past the stretch limit the principal stretches come from
+// the eigenvalues of C (s_1^2 = tr/2 + h, s_2^2 = det / s_1^2) instead of exp(L +- D)/4.
+#include <algorithm>
+#include <cstdint>
+
+#include "sim/shell/kl_batch.h"
+#include "sim/shell/kl_lanes.h"
+#include "sim/shell/laminate_energy.h"
+
+namespace shellmpm::kl {
+namespace {
+
+using lanes::any;
+using lanes::join;
+using lanes::part;
+using lanes::splat;
+using lanes::V3;
+using lanes::vlog;
+using lanes::vmax;
+using lanes::vsqrt;
+
+/// (p[0], p[1], p[2], 0) without reading past p[2].
+[[gnu::always_inline]] inline __m128 load3(const float* p) {
+  const __m128 xy = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(p)));
+  return _mm_movelh_ps(xy, _mm_load_ss(p + 2));
+}
+
+/// Rows r[j] (one point each, j < W) as four W-lane vectors: out[i] lane j = r[j][i].
+template <class F>
+[[gnu::always_inline]] inline void transpose_in(const __m128* r, F (&out)[4]) {
+  constexpr int W = lanes::kLanes<F>;
+  __m128 c[4][W / 4];
+  for (int g = 0; g < W / 4; ++g) {
+    __m128 r0 = r[4 * g], r1 = r[4 * g + 1], r2 = r[4 * g + 2], r3 = r[4 * g + 3];
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+    c[0][g] = r0;
+    c[1][g] = r1;
+    c[2][g] = r2;
+    c[3][g] = r3;
+  }
+  for (int i = 0; i < 4; ++i) out[i] = join<F>(c[i]);
+}
+
+/// layer_psi (laminate_energy.h) in lanes: psi, and dpsi/dM in S.
+template <class F>
+[[gnu::always_inline]] inline F layer_psi_lanes(const BatchData& d, const F (&Bp)[4], F m11, F m12,
+                                                F m22, F (&S)[3]) {
+  using I = decltype(m11 < m11);
+  const float mu = d.mu, lambda = d.lambda;
+  F c11, c12, c22;
+  layer_metric(Bp, m11, m12, m22, c11, c12, c22);
+  const F tr = c11 + c22;
+  const F det = c11 * c22 - c12 * c12;
+  const F hd = splat<F>(0.5f) * (c11 - c22);
+  const F h = vsqrt(hd * hd + c12 * c12);
+  const F x = splat<F>(2.0f) * h / tr;
+  // atanh(x) / x: the series below 1e-2, else log((1 + x) / (1 - x)) / (2 x).
+  const F x2 = x * x;
+  const F series =
+      splat<F>(1.0f) +
+      x2 * (splat<F>(1.0f / 3.0f) + x2 * (splat<F>(1.0f / 5.0f) + x2 * splat<F>(1.0f / 7.0f)));
+  const F full = splat<F>(0.5f) * vlog((splat<F>(1.0f) + x) / (splat<F>(1.0f) - x)) / x;
+  const F q = x < splat<F>(1e-2f) ? series : full;
+  const F L = vlog(det);
+  const F D = splat<F>(2.0f) * x * q;
+  F psi = splat<F>(0.125f * mu) * (L * L + D * D) + splat<F>(0.125f * lambda) * (L * L);
+  // dpsi/dC = k adj(C) + d I
+  const F beta = splat<F>(2.0f) * q / tr;
+  const F alpha = splat<F>(0.5f) * (L - beta * tr);
+  const F kk = (splat<F>(0.5f * mu) * alpha + splat<F>(0.25f * lambda) * L) / det;
+  const F dd = splat<F>(0.5f * mu) * beta;
+  F s11 = kk * c22 + dd, s12 = splat<F>(0.0f) - kk * c12, s22 = kk * c11 + dd;
+  // The stretch term where log s_1 = (L + D) / 4 passes log s_l.
+  const I beyond = splat<F>(0.25f) * (L + D) > splat<F>(d.log_limit);
+  if (any(beyond)) {
+    const F c1 = splat<F>(0.5f) * tr + h;
+    const F s1 = vsqrt(c1), s2 = vsqrt(det / c1);
+    const F lim = splat<F>(d.limit), ks = splat<F>(d.k);
+    const F d1 = vmax(s1 - lim, splat<F>(0.0f));
+    const F g1 = ks * d1 / s1;
+    const I both = s2 > lim;
+    const F d2 = s2 - lim;
+    // Both past the limit.
+    const F psi_b = ks * (d1 * d1 + d2 * d2);
+    const F sc_b = ks * lim / (s1 * s2 * (s1 + s2));
+    const F si_b = ks * d2 / s2 - sc_b * s2 * s2;
+    // Only the larger.
+    const F psi_o = ks * d1 * d1;
+    const F sc_o = d1 > splat<F>(0.0f) ? g1 / (splat<F>(2.0f) * h) : splat<F>(0.0f);
+    const F si_o = splat<F>(0.0f) - sc_o * s2 * s2;
+    const F add = both ? psi_b : psi_o;
+    const F sc = both ? sc_b : sc_o, si = both ? si_b : si_o;
+    psi = beyond ? psi + add : psi;
+    s11 = beyond ? s11 + (si + sc * c11) : s11;
+    s12 = beyond ? s12 + sc * c12 : s12;
+    s22 = beyond ? s22 + (si + sc * c22) : s22;
+  }
+  metric_adjoint(Bp, s11, s12, s22, S);
+  return psi;
+}
+
+template <int W>
+[[gnu::always_inline]] inline void eval_batch(const BatchData& d, std::size_t q0, std::size_t n,
+                                              const float* x, float* fe, float* energy_out,
+                                              float* a12_out) {
+  using F = typename lanes::Width<W>::F;
+  const std::size_t* const begin = d.begin;
+  const int* const ctrl = d.ctrl;
+  const float* const coef = d.coef;
+  const std::uint32_t* const slot = d.slot;
+  const int nl = d.num_layers;
+  for (std::size_t b = q0; b < q0 + n; b += W) {
+    const int cnt = static_cast<int>(std::min<std::size_t>(W, q0 + n - b));
+    // Lane j: point b + j; lanes past the end repeat the last point (results unused).
+    std::size_t qs[W];
+    for (int j = 0; j < W; ++j) qs[j] = b + static_cast<std::size_t>(std::min(j, cnt - 1));
+    // a_alpha, a_alphabeta of each point (gather_derivatives, x, y, z in the lanes of one
+    // SSE register), then transposed to one point per lane.
+    __m128 acc[5][W];
+    for (int j = 0; j < W; ++j) {
+      const std::size_t q = qs[j];
+      if (j >= cnt) {
+        for (int i = 0; i < 5; ++i) acc[i][j] = acc[i][cnt - 1];
+        continue;
+      }
+      for (int i = 0; i < 5; ++i) acc[i][j] = _mm_setzero_ps();
+      const __m128 x0 = load3(x + 3 * std::size_t(ctrl[begin[q]]));
+      for (std::size_t e = begin[q] + 1; e < begin[q + 1]; ++e) {
+        const __m128 dx = _mm_sub_ps(load3(x + 3 * std::size_t(ctrl[e])), x0);
+        const float* c = &coef[5 * e];
+        for (int i = 0; i < 5; ++i)
+          acc[i][j] = _mm_add_ps(acc[i][j], _mm_mul_ps(_mm_set1_ps(c[i]), dx));
+      }
+    }
+    V3<F> av[5];
+    for (int i = 0; i < 5; ++i) {
+      F t[4];
+      transpose_in<F>(acc[i], t);
+      av[i] = V3<F>{t[0], t[1], t[2]};
+    }
+    const V3<F> a1 = av[0], a2 = av[1], a11 = av[2], a12 = av[3], a22 = av[4];
+    // Kinematics (kl_kinematics.h, compute_kinematics).
+    const V3<F> nrm = cross(a1, a2);
+    const F inv_l = splat<F>(1.0f) / vsqrt(dot(nrm, nrm));
+    const V3<F> a3 = inv_l * nrm;
+    const V3<F> t1 = inv_l * (cross(a11, a2) + cross(a1, a12));
+    const V3<F> t2 = inv_l * (cross(a12, a2) + cross(a1, a22));
+    const V3<F> v1 = t1 - dot(a3, t1) * a3;
+    const V3<F> v2 = t2 - dot(a3, t2) * a3;
+    F area;
+    for (int j = 0; j < W; ++j) area[j] = d.area[qs[j]];
+    const V3<F> zero{splat<F>(0.0f), splat<F>(0.0f), splat<F>(0.0f)};
+    V3<F> Ga1 = zero, Ga2 = zero, Gv1 = zero, Gv2 = zero;
+    F energy = splat<F>(0.0f);
+    for (int l = 0; l < nl; ++l) {
+      const F xi3 = splat<F>(d.layer_xi3[l]);
+      const V3<F> g1 = a1 + xi3 * v1, g2 = a2 + xi3 * v2;
+      const F m11 = dot(g1, g1), m12 = dot(g1, g2), m22 = dot(g2, g2);
+      __m128 rows[W];
+      F Bp[4];
+      for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.B[4 * (qs[j] * nl + l)]);
+      transpose_in<F>(rows, Bp);
+      if (d.fp_inv) {
+        F Fi[4];
+        for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.fp_inv[4 * (qs[j] * nl + l)]);
+        transpose_in<F>(rows, Fi);
+        const F B0 = Bp[0], B1 = Bp[1], B2 = Bp[2], B3 = Bp[3];
+        Bp[0] = B0 * Fi[0] + B1 * Fi[2];
+        Bp[1] = B0 * Fi[1] + B1 * Fi[3];
+        Bp[2] = B2 * Fi[0] + B3 * Fi[2];
+        Bp[3] = B2 * Fi[1] + B3 * Fi[3];
+      }
+      const F V = area * splat<F>(d.layer_w[l]);
+      F S[3];
+      energy = energy + V * layer_psi_lanes<F>(d, Bp, m11, m12, m22, S);
+      if (fe) {
+        const F s = splat<F>(2.0f) * V;
+        const V3<F> dg1 = s * (S[0] * g1 + S[1] * g2);
+        const V3<F> dg2 = s * (S[1] * g1 + S[2] * g2);
+        Ga1 = Ga1 + dg1;
+        Ga2 = Ga2 + dg2;
+        Gv1 = Gv1 + xi3 * dg1;
+        Gv2 = Gv2 + xi3 * dg2;
+      }
+    }
+    for (int j = 0; j < cnt; ++j) {
+      energy_out[b - q0 + std::size_t(j)] = energy[j];
+      if (a12_out) {
+        float* o = a12_out + 6 * (b - q0 + std::size_t(j));
+        o[0] = a1.x[j], o[1] = a1.y[j], o[2] = a1.z[j];
+        o[3] = a2.x[j], o[4] = a2.y[j], o[5] = a2.z[j];
+      }
+    }
+    if (!fe) continue;
+    // Backpropagation through v_a = (I - a3 a3^T) m_a / l (eval_kinematics).
+    const V3<F> PG1 = Gv1 - dot(a3, Gv1) * a3, PG2 = Gv2 - dot(a3, Gv2) * a3;
+    const V3<F> cm1 = inv_l * PG1, cm2 = inv_l * PG2;
+    const V3<F> sum = dot(a3, t1) * PG1 + dot(a3, Gv1) * v1 + dot(Gv1, v1) * a3 +
+                      dot(a3, t2) * PG2 + dot(a3, Gv2) * v2 + dot(Gv2, v2) * a3;
+    const V3<F> cn = (splat<F>(0.0f) - inv_l) * sum;
+    Ga1 = Ga1 + (cross(a12, cm1) + cross(a22, cm2) + cross(a2, cn));
+    Ga2 = Ga2 + (cross(cm1, a11) + cross(cm2, a12) + cross(cn, a1));
+    const V3<F> G11 = cross(a2, cm1);
+    const V3<F> G12 = cross(cm1, a1) + cross(a2, cm2);
+    const V3<F> G22 = cross(cm2, a1);
+    const V3<F>* out[5] = {&Ga1, &Ga2, &G11, &G12, &G22};
+    // Per point j the five adjoints as (x, y, z, 0) (a 4x4 transpose per group of four
+    // lanes), then each entry's share c0 Ga1 + c1 Ga2 + c2 G11 + c3 G12 + c4 G22 as in
+    // entry_shares, one SSE store per entry.
+    __m128 G[5][W];
+    for (int i = 0; i < 5; ++i)
+      for (int g = 0; g < W / 4; ++g) {
+        __m128 r0 = part(out[i]->x, g), r1 = part(out[i]->y, g), r2 = part(out[i]->z, g),
+               r3 = _mm_setzero_ps();
+        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+        G[i][4 * g] = r0;
+        G[i][4 * g + 1] = r1;
+        G[i][4 * g + 2] = r2;
+        G[i][4 * g + 3] = r3;
+      }
+    for (int j = 0; j < cnt; ++j)
+      for (std::size_t e = begin[qs[j]], e1 = begin[qs[j] + 1]; e < e1; ++e) {
+        const float* c = &coef[5 * e];
+        const __m128 share =
+            _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(c[0]), G[0][j]),
+                                                        _mm_mul_ps(_mm_set1_ps(c[1]), G[1][j])),
+                                             _mm_mul_ps(_mm_set1_ps(c[2]), G[2][j])),
+                                  _mm_mul_ps(_mm_set1_ps(c[3]), G[3][j])),
+                       _mm_mul_ps(_mm_set1_ps(c[4]), G[4][j]));
+        _mm_storeu_ps(&fe[4 * std::size_t(slot[e])], share);
+      }
+  }
+}
+
+}  // namespace
+
+__attribute__((flatten)) void SHELLMPM_KL_BATCH_ENTRY(const BatchData& d, std::size_t q0,
+                                                      std::size_t n, const float* x, float* fe,
+                                                      float* energy, float* a12) {
+  eval_batch<SHELLMPM_KL_BATCH_WIDTH>(d, q0, n, x, fe, energy, a12);
+}
+
+}  // namespace shellmpm::kl
