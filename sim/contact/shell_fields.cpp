@@ -18,6 +18,7 @@ void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bul
   fields_.clear();
   folds_ = folds;
   active_ = num_shells >= 2 || (num_shells >= 1 && (bulk || folds));
+  heights_only_ = active_ && folds && num_shells == 1 && !bulk;
   if (!active_) return;
   fields_.resize(num_shells);
   for (Field& f : fields_) {
@@ -28,36 +29,69 @@ void ShellFields::setup(const SparseGrid& grid, std::size_t num_shells, bool bul
 
 ShellFields::PointShare::PointShare(const GridShell& gs, const Vec3& nj, const Vec3& f,
                                     std::uint32_t j, Real dx, Real dt, bool with_heights)
-    : heights(with_heights),
-      m(gs.shell->mass[j]),
-      mh(gs.held[j] == 7 ? m : Real(0)),
-      align(nj.dot(kAlign) >= 0 ? Real(1) : Real(-1)),
-      fx(f),
-      n(nj) {
-  A = (m * dx) * gs.contact->C[j];
-  base = m * gs.shell->v[j] + dt * gs.force[j] - A * fx;
+    : heights(with_heights), align(nj.dot(kAlign) >= 0 ? Real(1) : Real(-1)), fx(f), n(nj) {
+  // Node lanes: m, p (3), n (3), N (3), o (3), held, hmin, hmax; the height range is kept
+  // apart (add), its lanes add zero.
+  const Real m = gs.shell->mass[j];
+  const Mat3 A = (m * dx) * gs.contact->C[j];
+  const Vec3 base = m * gs.shell->v[j] + dt * gs.force[j] - A * fx;
+  const Real mh = gs.held[j] == 7 ? m : Real(0);
+  L0 = NodeLanes{} + Real(0);
+  Nn = L0;
+  L0[0] = m;
+  L0[13] = mh;
+  for (int a = 0; a < 3; ++a) {
+    L0[1 + a] = base[a];
+    L0[7 + a] = m * n[a];    // N: the shell's own normal
+    L0[10 + a] = m * fx[a];  // o: m (fx - offset)
+    Nn[4 + a] = m * n[a];    // n: turned to the node's side
+    Li[a] = NodeLanes{} + Real(0);
+    for (int c = 0; c < 3; ++c) Li[a][1 + c] = A(c, a);
+    Li[a][10 + a] = -m;
+  }
 }
 
-void ShellFields::PointShare::add(Node& d, Real w, int i, int j, int k) const {
-  const Vec3 ijk{Real(i), Real(j), Real(k)};
-  const Vec3 mom = w * (base + A * ijk);
-  // The normal turned to the node's side of the shell.
-  const Real side = n.dot(ijk - fx);
-  const Real wn = side > 0 ? w * m : side < 0 ? -w * m : Real(0);
-  const Vec3 off = fx - ijk;
-  d.m += w * m;
-  d.held += w * mh;
-  for (int a = 0; a < 3; ++a) {
-    d.p[a] += mom[a];
-    d.n[a] += wn * n[a];
-    d.N[a] += w * m * n[a];
-    d.o[a] += w * m * off[a];
-  }
-  if (heights && w > 0) {
-    const Real h = align * side;  // fold_height
-    d.hmin = std::min(d.hmin, h);
-    d.hmax = std::max(d.hmax, h);
-  }
+void ShellFields::normalise(Node& d) {
+  if (d.m > 0)
+    for (int a = 0; a < 3; ++a) {
+      d.p[a] /= d.m;
+      d.o[a] /= d.m;
+    }
+}
+
+void ShellFields::shell_p2g_heights(Field& F, const GridShell& gs, Real dt, bool serial) {
+  const ShellObject& sh = *gs.shell;
+  const std::size_t ng = F.grid.num_grid_blocks();
+  F.heights.resize(ng);
+  const Real dx = static_cast<Real>(F.grid.dx());
+  parallel_for_each(
+      ng, 16,
+      [&](std::size_t g) {
+        F.heights[g].fill(
+            {Real(0), std::numeric_limits<Real>::max(), std::numeric_limits<Real>::lowest()});
+        F.r[g].fill(Vec3::Zero());
+      },
+      serial);
+  F.grid.for_each_block_by_colour(
+      [&](std::size_t b) {
+        const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
+        F.grid.for_each_point(b, [&](std::uint32_t j) {
+          const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
+          const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, true);
+          const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+          for (int i = 0; i < 3; ++i)
+            for (int jj = 0; jj < 3; ++jj) {
+              PointShare::Row r;
+              P.row(i, jj, r);
+              const Real wxy = W.w[0][i] * W.w[1][jj];
+              for (int k = 0; k < 3; ++k) {
+                const auto [g, node] = F.grid.pad_to_grid(b, lx + i, ly + jj, lz + k);
+                P.add_heights(F.heights[g][node], wxy * W.w[2][k], r, k);
+              }
+            }
+        });
+      },
+      serial);
 }
 
 void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial) {
@@ -78,6 +112,19 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
   F.nodes.resize(ng);
   F.r.resize(ng);
   const Real dx = static_cast<Real>(F.grid.dx());
+  if (heights_only_) {
+    shell_p2g_heights(F, gs, dt, serial);
+    split_folds(F, gs, dt, serial);
+    parallel_for_each(
+        ng, 16,
+        [&](std::size_t g) {
+          if (F.fold[g] < 0) return;
+          for (Node& d : F.nodes[g]) normalise(d);
+          for (Node& d : F.folds[F.fold[g]].second) normalise(d);
+        },
+        serial);
+    return;
+  }
   parallel_for_each(
       ng, 16,
       [&](std::size_t g) {
@@ -93,22 +140,22 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
         F.grid.for_each_point(b, [&](std::uint32_t j) {
           const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
           const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, folds_);
-          for_each_stencil_node(W, bc, [&](const StencilNode& n) {
-            const auto [g, k] = F.grid.pad_to_grid(b, n.px, n.py, n.pz);
-            P.add(F.nodes[g][k], n.w, n.i, n.j, n.k);
-          });
+          const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+          for (int i = 0; i < 3; ++i)
+            for (int jj = 0; jj < 3; ++jj) {
+              PointShare::Row r;
+              P.row(i, jj, r);
+              const Real wxy = W.w[0][i] * W.w[1][jj];
+              for (int k = 0; k < 3; ++k) {
+                const auto [g, node] = F.grid.pad_to_grid(b, lx + i, ly + jj, lz + k);
+                P.add(F.nodes[g][node], wxy * W.w[2][k], r, k);
+              }
+            }
         });
       },
       serial);
   // Momentum to velocity, first moment to centroid offset: right after the sums, or,
   // with fold fields, after split_folds has used the sums.
-  const auto normalise = [](Node& d) {
-    if (d.m > 0)
-      for (int a = 0; a < 3; ++a) {
-        d.p[a] /= d.m;
-        d.o[a] /= d.m;
-      }
-  };
   if (!folds_) {
     parallel_for_each(
         ng, 16,
@@ -212,6 +259,7 @@ Real ShellFields::node_bodies(std::size_t g, int n, std::vector<Body>& bodies) {
   for (std::size_t s = 0; s < fields_.size(); ++s) {
     if (fb[s] < 0) continue;
     Field& F = fields_[s];
+    if (heights_only_ && F.fold[fb[s]] < 0) continue;  // one body at most
     const auto push = [&](const Node& f, Vec3& r) {
       if (f.m <= 0) return;
       ms += f.m;
@@ -340,6 +388,8 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
         std::vector<Body> bodies;
         for (std::size_t g = gb; g < ge; ++g) {
           if (!fielded_[g]) continue;
+          // Heights only: two bodies only on the shell's fold blocks.
+          if (heights_only_ && fields_[0].fold[fblock_[g]] < 0) continue;
           r_bulk_[g].fill(Vec3::Zero());
           for (int n = 0; n < kBlockNodes; ++n) {
             const GridNode& cn = combined.gblock_nodes[g][n];
@@ -394,6 +444,10 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
         [&](std::size_t b) {
           const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
           const auto& nbr = F.grid.pblock_nbr[b];
+          // Heights only: relative velocities exist on fold blocks only.
+          if (heights_only_ &&
+              std::none_of(nbr.begin(), nbr.end(), [&](int g) { return g >= 0 && F.fold[g] >= 0; }))
+            return;
           for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
             const std::uint32_t j = F.grid.order()[q];
             const QuadraticWeights W(F.grid.grid_coord(F.x0[j]));

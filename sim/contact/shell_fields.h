@@ -129,41 +129,100 @@ class ShellFields {
   /// kAlign's side: every point of one flat layer gives the same, whatever the layer's
   /// orientation, and two layers differ by their distance.
   static Real fold_height(const Vec3& n, const Vec3& fx, int i, int j, int k) {
-    const Real h = n.dot(Vec3(Real(i), Real(j), Real(k)) - fx);
+    const Real h = side_of(n, fx, i, j, k);
     return n.dot(kAlign) >= 0 ? h : -h;
   }
+  /// n . ((i, j, k) - fx), summed in this order (PointShare's rows give the same bits).
+  static Real side_of(const Vec3& n, const Vec3& fx, int i, int j, int k) {
+    return (n[0] * (Real(i) - fx[0]) + n[1] * (Real(j) - fx[1])) + n[2] * (Real(k) - fx[2]);
+  }
   static bool is_split(const FoldBlock& fb, int bn) { return fb.split[bn] != 0; }
+  /// A node's mass and height range (Node's m, hmin, hmax) where heights_only_.
+  struct Heights {
+    Real m, hmin, hmax;
+  };
   struct Field {
     SparseGrid grid;  ///< binning of this shell's control points (no grid nodes)
-    std::vector<std::array<Node, kBlockNodes>> nodes;  ///< the shell, or its first class
-    std::vector<std::array<Vec3, kBlockNodes>> r;      ///< velocity relative to the node
-    std::vector<Vec3> x0;                              ///< control points at p2g time
-    std::vector<Vec3> normal;                          ///< control-point unit normals
+    /// The shell, or its first class (heights_only_: set on fold blocks only).
+    std::vector<std::array<Node, kBlockNodes>> nodes;
+    std::vector<std::array<Heights, kBlockNodes>> heights;  ///< heights_only_
+    std::vector<std::array<Vec3, kBlockNodes>> r;           ///< velocity relative to the node
+    std::vector<Vec3> x0;                                   ///< control points at p2g time
+    std::vector<Vec3> normal;                               ///< control-point unit normals
     std::vector<int> fold;         ///< per grid block: index into folds, -1: no fold
     std::vector<FoldBlock> folds;  ///< grid blocks where the shell folds, in block order
     std::vector<int> touched;      ///< per particle block: index into the fold buffers
     std::vector<std::array<Classes, kPadNodes>> class_buf;
   };
-  /// One control point's share of its 27 stencil nodes in a field's P2G.
+  /// A node's 16 scalars (Node's layout) as one vector: one AVX-512 register, four SSE.
+  typedef Real NodeLanes __attribute__((vector_size(16 * sizeof(Real))));
+  static_assert(sizeof(Node) == sizeof(NodeLanes), "a node is sixteen scalars");
+  /// One control point's share of its 27 stencil nodes in a field's P2G. The share at
+  /// stencil offset (i, j, k) is w (L0 + i Li[0] + j Li[1] + k Li[2] +- Nn), linear in the
+  /// offset but for the normal turned to the node's side (the sign of side_of), computed
+  /// once per stencil row (i, j) and then per node along k.
   struct PointShare {
     bool heights;  ///< keep the nodes' height range (fold fields on)
-    Real m, mh;    ///< mass; its fully pinned part
     Real align;    ///< +1 or -1: n turned to kAlign's side
-    Vec3 fx, base, n;
-    Mat3 A;
+    Vec3 fx, n;
+    NodeLanes L0, Li[3], Nn;
+    /// Row (i, j) of the stencil: L0 + i Li[0] + j Li[1], and side_of's first two terms.
+    struct Row {
+      NodeLanes L;
+      Real side;
+    };
     PointShare(const GridShell& gs, const Vec3& n, const Vec3& fx, std::uint32_t j, Real dx,
                Real dt, bool with_heights);
-    /// Adds the weight-w share at stencil offset (i, j, k) to d.
-    void add(Node& d, Real w, int i, int j, int k) const;
+    [[gnu::always_inline]] void row(int i, int j, Row& r) const {
+      r.L = (L0 + Real(i) * Li[0]) + Real(j) * Li[1];
+      r.side = n[0] * (Real(i) - fx[0]) + n[1] * (Real(j) - fx[1]);
+    }
+    /// Adds the weight-w share at node k of row r to d.
+    [[gnu::always_inline]] void add(Node& d, Real w, const Row& r, int k) const {
+      const Real side = r.side + n[2] * (Real(k) - fx[2]);
+      NodeLanes v = r.L + Real(k) * Li[2];
+      if (side > 0) v = v + Nn;
+      if (side < 0) v = v - Nn;
+      NodeLanes a;
+      std::memcpy(&a, &d, sizeof a);
+      a = a + w * v;
+      std::memcpy(&d, &a, sizeof a);
+      if (heights && w > 0) {
+        const Real h = align * side;  // fold_height
+        d.hmin = std::min(d.hmin, h);
+        d.hmax = std::max(d.hmax, h);
+      }
+    }
+    /// Only the mass and height range of that share (heights_only_), the same bits as
+    /// add's.
+    [[gnu::always_inline]] void add_heights(Heights& d, Real w, const Row& r, int k) const {
+      const Real side = r.side + n[2] * (Real(k) - fx[2]);
+      d.m += w * L0[0];
+      if (w > 0) {
+        const Real h = align * side;  // fold_height
+        d.hmin = std::min(d.hmin, h);
+        d.hmax = std::max(d.hmax, h);
+      }
+    }
+    /// The same at stencil offset (i, j, k).
+    void add(Node& d, Real w, int i, int j, int k) const {
+      Row r;
+      row(i, j, r);
+      add(d, w, r, k);
+    }
   };
   void shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial);
+  /// shell_p2g's sums of mass and heights only, into F.heights (heights_only_).
+  void shell_p2g_heights(Field& F, const GridShell& gs, Real dt, bool serial);
+  /// Momentum to velocity, first moment to centroid offset.
+  static void normalise(Node& d);
   /// Between the sums and their normalisation in shell_p2g: finds the nodes where F's
   /// shell folds and splits its control points there into two classes (shell_folds.cpp).
   void split_folds(Field& F, const GridShell& gs, Real dt, bool serial);
   /// split_folds' steps: the nodes whose heights spread (F.fold, F.folds with their cuts);
   /// both classes scattered from the particle blocks next to split nodes (F.touched,
   /// F.class_buf); their sums gathered into F.nodes and the second fields.
-  static void mark_split_nodes(Field& F);
+  static void mark_split_nodes(Field& F, bool heights_only);
   void scatter_classes(Field& F, const GridShell& gs, Real dt, bool serial);
   static void gather_classes(Field& F, bool serial);
   /// A body at a node: a shell there, or one of its two classes where it folds.
@@ -203,6 +262,11 @@ class ShellFields {
                     bool serial);
   bool active_ = false;
   bool folds_ = false;  ///< split_folds on
+  /// One shell and no bulk material: a node holds two bodies only where the shell folds
+  /// (its two classes), so the field's P2G sums only mass and heights (Field::heights),
+  /// and full sums (Field::nodes) exist on fold blocks only, from the classes. Every other
+  /// node keeps one velocity, as it would with the full sums (one body there).
+  bool heights_only_ = false;
   std::vector<Field> fields_;
   std::vector<Real> friction_;  ///< per shell: c_F against bulk material
   // Per combined grid block: the fields' block indices (-1: absent), the bulk field's

@@ -30,16 +30,23 @@ namespace {
 constexpr Real kMinRange = Real(1.0);
 }  // namespace
 
-void ShellFields::mark_split_nodes(Field& F) {
+void ShellFields::mark_split_nodes(Field& F, bool heights_only) {
   const std::size_t ng = F.grid.num_grid_blocks();
   F.fold.assign(ng, -1);
   F.folds.clear();
   for (std::size_t g = 0; g < ng; ++g) {
-    const auto& nodes = F.nodes[g];
     for (int n = 0; n < kBlockNodes; ++n) {
-      const Node& d = nodes[n];
+      Heights d;
+      if (heights_only) {
+        d = F.heights[g][n];
+      } else {
+        const Node& f = F.nodes[g][n];
+        d = {f.m, f.hmin, f.hmax};
+      }
       if (!(d.m > 0) || !(d.hmax - d.hmin >= kMinRange)) continue;
       if (F.fold[g] < 0) {
+        // Heights only: the full sums of a fold block come from its classes alone.
+        if (heights_only) Node::clear(F.nodes[g].data(), kBlockNodes);
         F.fold[g] = static_cast<int>(F.folds.size());
         FoldBlock& fb = F.folds.emplace_back();
         fb.split.fill(0);
@@ -132,7 +139,7 @@ void ShellFields::gather_classes(Field& F, bool serial) {
 
 void ShellFields::split_folds(Field& F, const GridShell& gs, Real dt, bool serial) {
   // 1. The nodes whose heights spread: cut at the midpoint.
-  mark_split_nodes(F);
+  mark_split_nodes(F, heights_only_);
   if (F.folds.empty()) return;
   // 2. Both classes, summed as the whole shell was, on the particle blocks that scatter to
   //    a split node; a node stays whole where one class is empty.

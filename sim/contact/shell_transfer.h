@@ -17,6 +17,7 @@
 // pair stays energy-consistent (tests/sim/contact/test_contact_grid.cpp checks it).
 #pragma once
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "sim/contact/shell_contact.h"
@@ -83,9 +84,7 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
 /// 27 outer products up to round-off.
 struct SiteMoments {
   int base[3];
-  Real w[27];
-  Real a[27];
-  bool massive[27];
+  Real a[28];  ///< a[27]: scratch (the rows are written four scalars at a time)
   Real e[3][3];
   Mat3 Minv;
   bool any = false;  ///< false: no stencil node has mass (e and Minv unset)
@@ -104,31 +103,40 @@ struct SiteMoments {
 };
 /// The moments of the point with weights W on a grid of spacing dx [m]. The stencil is
 /// walked with for_each_stencil_node(W, block_corner, ...) (sim/mpm/apic_stencil.h);
-/// mass(const StencilNode&) gives the mass of a node.
+/// mass(const StencilNode&) gives the mass of a node (>= 0). The sums run on the stencil's
+/// nine rows along z as short vectors: a row's a = (wx wy) (wz m), its marginals added
+/// row by row.
 template <class MassFn>
 SiteMoments site_moments(const QuadraticWeights& W, Real dx, const Vec3i& block_corner,
                          MassFn mass) {
+  typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
   SiteMoments sm;
   for (int a = 0; a < 3; ++a) sm.base[a] = W.base[a];
-  // Two-axis marginals of a: Aij = sum_k a, Aik = sum_j a, Ajk = sum_i a.
-  Real Aij[3][3] = {}, Aik[3][3] = {}, Ajk[3][3] = {};
+  Real m[28];
+  m[27] = 0;
   int n = 0;
-  for_each_stencil_node(W, block_corner, [&](const StencilNode& nd) {
-    sm.w[n] = nd.w;
-    const Real m = mass(nd);
-    sm.massive[n] = m > 0;
-    const Real an = sm.massive[n] ? sm.w[n] * m : Real(0);
-    sm.a[n] = an;
-    Aij[nd.i][nd.j] += an;
-    Aik[nd.i][nd.k] += an;
-    Ajk[nd.j][nd.k] += an;
-    ++n;
-  });
+  for_each_stencil_node(W, block_corner, [&](const StencilNode& nd) { m[n++] = mass(nd); });
+  const R4 wz = {W.w[2][0], W.w[2][1], W.w[2][2], Real(0)};
+  // Two-axis marginals of a: Aij = sum_k a, Aik = sum_j a, Ajk = sum_i a (rows over k).
+  Real Aij[3][3];
+  R4 Aik[3] = {}, Ajk[3] = {};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      R4 mr;
+      std::memcpy(&mr, &m[9 * i + 3 * j], sizeof mr);
+      mr[3] = 0;
+      const R4 ar = (W.w[0][i] * W.w[1][j]) * (wz * mr);
+      std::memcpy(&sm.a[9 * i + 3 * j], &ar, sizeof ar);
+      Aij[i][j] = (ar[0] + ar[1]) + ar[2];
+      Aik[i] += ar;
+      Ajk[j] += ar;
+    }
   Real A[3][3];  // one-axis marginals A[axis][o]
+  const R4 Az = (Aik[0] + Aik[1]) + Aik[2];
   for (int o = 0; o < 3; ++o) {
     A[0][o] = Aij[o][0] + Aij[o][1] + Aij[o][2];
     A[1][o] = Aij[0][o] + Aij[1][o] + Aij[2][o];
-    A[2][o] = Aik[0][o] + Aik[1][o] + Aik[2][o];
+    A[2][o] = Az[o];
   }
   const Real asum = A[0][0] + A[0][1] + A[0][2];
   sm.any = asum > 0;
@@ -146,13 +154,14 @@ SiteMoments site_moments(const QuadraticWeights& W, Real dx, const Vec3i& block_
   for (int ax = 0; ax < 3; ++ax)
     M(ax, ax) = reg + A[ax][0] * sm.e[ax][0] * sm.e[ax][0] + A[ax][1] * sm.e[ax][1] * sm.e[ax][1] +
                 A[ax][2] * sm.e[ax][2] * sm.e[ax][2];
+  const R4 ez = {sm.e[2][0], sm.e[2][1], sm.e[2][2], Real(0)};
   Real mxy = 0, mxz = 0, myz = 0;
-  for (int p = 0; p < 3; ++p)
-    for (int r = 0; r < 3; ++r) {
-      mxy += Aij[p][r] * sm.e[0][p] * sm.e[1][r];
-      mxz += Aik[p][r] * sm.e[0][p] * sm.e[2][r];
-      myz += Ajk[p][r] * sm.e[1][p] * sm.e[2][r];
-    }
+  for (int p = 0; p < 3; ++p) {
+    for (int r = 0; r < 3; ++r) mxy += Aij[p][r] * sm.e[0][p] * sm.e[1][r];
+    const R4 xz = Aik[p] * ez, yz = Ajk[p] * ez;
+    mxz += sm.e[0][p] * ((xz[0] + xz[1]) + xz[2]);
+    myz += sm.e[1][p] * ((yz[0] + yz[1]) + yz[2]);
+  }
   M(0, 1) = M(1, 0) = mxy;
   M(0, 2) = M(2, 0) = mxz;
   M(1, 2) = M(2, 1) = myz;
@@ -179,10 +188,11 @@ SiteStencil site_stencil(const SparseGrid& grid, const Vec3& x, MassFn mass) {
       [&](const StencilNode& n) { return mass(base[0] + n.i, base[1] + n.j, base[2] + n.k); });
   SiteStencil st;
   for (int a = 0; a < 3; ++a) st.base[a] = sm.base[a];
-  for (int n = 0; n < 27; ++n) {
-    st.w[n] = sm.w[n];
-    st.massive[n] = sm.massive[n];
-  }
+  int at = 0;
+  for_each_stencil_node(W, base, [&](const StencilNode& nd) {
+    st.w[at] = nd.w;
+    st.massive[at++] = mass(base[0] + nd.i, base[1] + nd.j, base[2] + nd.k) > 0;
+  });
   st.any = sm.any;
   if (!st.any) {
     for (int n = 0; n < 27; ++n) st.grad[n].setZero();

@@ -106,3 +106,40 @@ TEST_CASE("a fold of one cloth sticks below the friction angle and slides freely
   INFO("30 deg, c_F 0: acceleration " << free.a << " m/s^2, g sin " << g_sin);
   CHECK(free.a == Approx(g_sin).epsilon(0.05));
 }
+
+TEST_CASE("one folding shell alone (mass and heights only off its folds) moves as with full fields",
+          "[contact]") {
+  // Alone, the cloth's field sums only mass and heights outside its fold blocks
+  // (ShellFields::heights_only_); with a second shell far away every node gets the full
+  // sums. Nothing can differ: away from the folds a node holds one body either way.
+  const Scene alone = fold_on_slope(30, 0.3, true, true, 0.03);  // layers 1.5 dx apart: folds
+  Scene two = alone;
+  ShellDesc far;
+  far.name = "far";
+  far.kind = ShellDesc::Kind::Sheet;
+  far.size[0] = far.size[1] = 0.16;
+  far.resolution[0] = far.resolution[1] = 8;
+  far.translate = Vec3d(0.7, 0.7, 0.7);
+  far.contact = ShellDesc::Contact::On;
+  PinDesc all;
+  for (int i = 0; i < 81; ++i) all.indices.push_back(i);
+  far.pins.push_back(all);
+  two.shells.push_back(far);
+  Solver a(alone), b(two);
+  REQUIRE(a.shell_on_grid(0));
+  REQUIRE(b.shell_on_grid(1));
+  REQUIRE(a.stable_dt() == b.stable_dt());
+  a.advance_to(0.05);
+  b.advance_to(0.05);
+  const ShellObject &sa = *a.shells()[0], &sb = *b.shells()[0];
+  REQUIRE(sa.size() == sb.size());
+  // The fold piece has moved down the slope, on the cloth (not through it).
+  double moved = 0;
+  for (std::size_t j = kBasePoints; j < sa.size(); ++j)
+    moved = std::max(moved, double((sa.x[j] - sa.rest[j].cast<Real>()).norm()));
+  CHECK(moved > 2e-3);
+  std::size_t differ = 0;
+  for (std::size_t j = 0; j < sa.size(); ++j)
+    if (sa.x[j] != sb.x[j] || sa.v[j] != sb.v[j]) ++differ;
+  CHECK(differ == 0);
+}
