@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
@@ -77,24 +76,14 @@ ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& res
 void ShellContact::tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2) const {
   // Differences to the first control point: the dN sum to zero, so this is exact and
   // keeps float precision far from the origin.
-  // (x, y, z, 0) in a short vector: the same operations per axis as with Vec3, without
-  // the scalar code's three of each.
-  typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
-  const auto load = [&](std::uint32_t k) {
-    R4 v;
-    std::memcpy(&v, ctrl[idx[k]].data(), 3 * sizeof(Real));
-    v[3] = 0;
-    return v;
-  };
-  const R4 ref = load(off[p]);
-  R4 s1 = {}, s2 = {};
+  const Vec3 ref = ctrl[idx[off[p]]];
+  a1.setZero();
+  a2.setZero();
   for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
-    const R4 d = load(k) - ref;
-    s1 += N1[k] * d;
-    s2 += N2[k] * d;
+    const Vec3 d = ctrl[idx[k]] - ref;
+    a1 += N1[k] * d;
+    a2 += N2[k] * d;
   }
-  a1 = Vec3(s1[0], s1[1], s1[2]);
-  a2 = Vec3(s2[0], s2[1], s2[2]);
 }
 
 void ShellContact::update_positions(const Vec3* ctrl, bool serial) {
