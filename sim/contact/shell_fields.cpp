@@ -51,6 +51,33 @@ ShellFields::PointShare::PointShare(const GridShell& gs, const Vec3& nj, const V
   }
 }
 
+template <class AddFn>
+void ShellFields::scatter_shares(Field& F, const GridShell& gs, Real dt, bool heights, bool serial,
+                                 AddFn add) {
+  const ShellObject& sh = *gs.shell;
+  const Real dx = static_cast<Real>(F.grid.dx());
+  F.grid.for_each_block_by_colour(
+      [&](std::size_t b) {
+        const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
+        F.grid.for_each_point(b, [&](std::uint32_t j) {
+          const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
+          const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, heights);
+          const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+          for (int i = 0; i < 3; ++i)
+            for (int jj = 0; jj < 3; ++jj) {
+              PointShare::Row r;
+              P.row(i, jj, r);
+              const Real wxy = W.w[0][i] * W.w[1][jj];
+              for (int k = 0; k < 3; ++k) {
+                const auto [g, node] = F.grid.pad_to_grid(b, lx + i, ly + jj, lz + k);
+                add(P, r, g, node, wxy * W.w[2][k], k);
+              }
+            }
+        });
+      },
+      serial);
+}
+
 void ShellFields::normalise(Node& d) {
   if (d.m > 0)
     for (int a = 0; a < 3; ++a) {
@@ -60,10 +87,8 @@ void ShellFields::normalise(Node& d) {
 }
 
 void ShellFields::shell_p2g_heights(Field& F, const GridShell& gs, Real dt, bool serial) {
-  const ShellObject& sh = *gs.shell;
   const std::size_t ng = F.grid.num_grid_blocks();
   F.heights.resize(ng);
-  const Real dx = static_cast<Real>(F.grid.dx());
   parallel_for_each(
       ng, 16,
       [&](std::size_t g) {
@@ -72,26 +97,9 @@ void ShellFields::shell_p2g_heights(Field& F, const GridShell& gs, Real dt, bool
         F.r[g].fill(Vec3::Zero());
       },
       serial);
-  F.grid.for_each_block_by_colour(
-      [&](std::size_t b) {
-        const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
-        F.grid.for_each_point(b, [&](std::uint32_t j) {
-          const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
-          const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, true);
-          const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-          for (int i = 0; i < 3; ++i)
-            for (int jj = 0; jj < 3; ++jj) {
-              PointShare::Row r;
-              P.row(i, jj, r);
-              const Real wxy = W.w[0][i] * W.w[1][jj];
-              for (int k = 0; k < 3; ++k) {
-                const auto [g, node] = F.grid.pad_to_grid(b, lx + i, ly + jj, lz + k);
-                P.add_heights(F.heights[g][node], wxy * W.w[2][k], r, k);
-              }
-            }
-        });
-      },
-      serial);
+  scatter_shares(F, gs, dt, true, serial,
+                 [&](const PointShare& P, const PointShare::Row& r, int g, int node, Real w,
+                     int k) { P.add_heights(F.heights[g][node], w, r, k); });
 }
 
 void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial) {
@@ -111,7 +119,6 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
   const std::size_t ng = F.grid.num_grid_blocks();
   F.nodes.resize(ng);
   F.r.resize(ng);
-  const Real dx = static_cast<Real>(F.grid.dx());
   if (heights_only_) {
     shell_p2g_heights(F, gs, dt, serial);
     split_folds(F, gs, dt, serial);
@@ -134,26 +141,9 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
       serial);
   // Straight into the nodes, colour by colour (blocks of a colour touch disjoint nodes):
   // no buffer per block to clear and gather.
-  F.grid.for_each_block_by_colour(
-      [&](std::size_t b) {
-        const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
-        F.grid.for_each_point(b, [&](std::uint32_t j) {
-          const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
-          const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, folds_);
-          const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
-          for (int i = 0; i < 3; ++i)
-            for (int jj = 0; jj < 3; ++jj) {
-              PointShare::Row r;
-              P.row(i, jj, r);
-              const Real wxy = W.w[0][i] * W.w[1][jj];
-              for (int k = 0; k < 3; ++k) {
-                const auto [g, node] = F.grid.pad_to_grid(b, lx + i, ly + jj, lz + k);
-                P.add(F.nodes[g][node], wxy * W.w[2][k], r, k);
-              }
-            }
-        });
-      },
-      serial);
+  scatter_shares(F, gs, dt, folds_, serial,
+                 [&](const PointShare& P, const PointShare::Row& r, int g, int node, Real w,
+                     int k) { P.add(F.nodes[g][node], w, r, k); });
   // Momentum to velocity, first moment to centroid offset: right after the sums, or,
   // with fold fields, after split_folds has used the sums.
   if (!folds_) {

@@ -212,6 +212,10 @@ class ShellFields {
     }
   };
   void shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial);
+  /// Walks F's control points colour by colour (blocks of a colour touch disjoint nodes)
+  /// and calls add(P, row, grid block, node, w, k) for each of their 27 stencil nodes.
+  template <class AddFn>
+  void scatter_shares(Field& F, const GridShell& gs, Real dt, bool heights, bool serial, AddFn add);
   /// shell_p2g's sums of mass and heights only, into F.heights (heights_only_).
   void shell_p2g_heights(Field& F, const GridShell& gs, Real dt, bool serial);
   /// Momentum to velocity, first moment to centroid offset.

@@ -324,9 +324,10 @@ void add_bulk_counts(const Scene& scene, MemoryCounts& n) {
 
 /// Per-shell velocity fields (shot.shell_velocities: per_shell) when two bodies share the
 /// grid (two shells, a shell and bulk, or a shell's folds): each bins its control points
-/// into its own grid and keeps 4^3 nodes of 16 Reals (no buffers); the combined grid
-/// keeps the bulk moments. Fold blocks are transient and few (a crumple's folds cover a
-/// fraction of its blocks). 0 when the fields are off.
+/// into its own grid and keeps 4^3 nodes of 16 Reals (a lone shell 3 more: mass and
+/// height range; no buffers); the combined grid keeps the bulk moments. Fold blocks are
+/// transient and few (a crumple's folds cover a fraction of its blocks). 0 when the fields
+/// are off.
 double fields_memory(const Scene& scene, const ShellTotals& t, const MemoryCounts& n) {
   const ShotSettings& shot = scene.shot;
   const std::size_t grid_shells = t.grid_shells;
@@ -336,9 +337,12 @@ double fields_memory(const Scene& scene, const ShellTotals& t, const MemoryCount
       (grid_shells >= 2 || (grid_shells >= 1 && (shot.fold_fields || !scene.sources.empty())));
   double fields_bytes = 0;
   if (!fields) return fields_bytes;
+  // One shell without bulk also keeps mass and height range per node (heights only).
+  const bool heights = grid_shells == 1 && scene.sources.empty();
   for (double pb : t.shell_pblocks) {
     const double gb = 2.2 * pb;
-    fields_bytes += grid_bytes(0, pb, gb, false, true, false) + gb * 64 * (16 * R + kVec3);
+    fields_bytes += grid_bytes(0, pb, gb, false, true, false) +
+                    gb * 64 * (16 * R + kVec3 + (heights ? 3 * R : 0));
   }
   fields_bytes += 24 * n.shell_points + n.particle_blocks * 216 * 4 * R +
                   n.grid_blocks * (64 * kVec3 + 64 * 4 * R + 4 * grid_shells + 1);
