@@ -236,6 +236,9 @@ void ShellFields::find_field_blocks(const SparseGrid& combined, bool serial) {
         int* fb = fblock_.data() + g * K;
         for (std::size_t s = 0; s < K; ++s) {
           fb[s] = fields_[s].grid.find_grid_block(combined.gblock_key[g]);
+          // Heights only: a node has two bodies only on the shell's fold blocks; elsewhere
+          // the field has no full sums and the node keeps one velocity.
+          if (heights_only_ && fb[s] >= 0 && fields_[s].fold[fb[s]] < 0) fb[s] = -1;
           if (fb[s] >= 0) fielded_[g] = 1;
         }
       },
@@ -249,7 +252,6 @@ Real ShellFields::node_bodies(std::size_t g, int n, std::vector<Body>& bodies) {
   for (std::size_t s = 0; s < fields_.size(); ++s) {
     if (fb[s] < 0) continue;
     Field& F = fields_[s];
-    if (heights_only_ && F.fold[fb[s]] < 0) continue;  // one body at most
     const auto push = [&](const Node& f, Vec3& r) {
       if (f.m <= 0) return;
       ms += f.m;
@@ -378,8 +380,6 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
         std::vector<Body> bodies;
         for (std::size_t g = gb; g < ge; ++g) {
           if (!fielded_[g]) continue;
-          // Heights only: two bodies only on the shell's fold blocks.
-          if (heights_only_ && fields_[0].fold[fblock_[g]] < 0) continue;
           r_bulk_[g].fill(Vec3::Zero());
           for (int n = 0; n < kBlockNodes; ++n) {
             const GridNode& cn = combined.gblock_nodes[g][n];

@@ -146,39 +146,24 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
   const std::uint32_t nc = table.num_control_points();
   const auto ns = static_cast<std::uint32_t>(table.size());
   const std::vector<std::uint32_t>& order = grid.order();
-  const auto site = [&](std::uint32_t s) -> std::pair<const ShellContact*, std::uint32_t> {
-    const std::uint32_t g = order[s];
-    return {shells[table.shell(g)].contact, table.local(g)};
-  };
-  // Only the particle blocks with a site under compression (G3 != 0) do anything: a few
-  // percent of the sites in a usual step.
-  const std::size_t nb = grid.num_particle_blocks();
-  std::vector<std::uint8_t> active(nb, 0);
-  parallel_for_each(
-      nb, 16,
-      [&](std::size_t b) {
-        const auto [lo, hi] = slice(grid, b, nc, ns);
-        for (std::uint32_t s = lo; s < hi && !active[b]; ++s) {
-          const auto [c, p] = site(s);
-          active[b] = c->G3[p].squaredNorm() != 0;
-        }
-      },
-      serial);
-  // Colour by colour (blocks of a colour touch disjoint nodes): each active block reads
-  // its nodes' masses and adds its velocity increments straight into the grid.
+  // Colour by colour (blocks of a colour touch disjoint nodes): each block with contact
+  // particles reads its nodes' masses and adds its velocity increments straight into the
+  // grid. (Nearly every site has G3 != 0: the shear term alone makes it nonzero.)
   const Real dx = static_cast<Real>(grid.dx());
   grid.for_each_block_by_colour(
       [&](std::size_t b) {
-        if (!active[b]) return;
+        const auto [lo, hi] = slice(grid, b, nc, ns);
+        if (lo == hi) return;
         GridNode pad[kPadNodes], inc[kPadNodes];
         std::memset(static_cast<void*>(pad), 0, sizeof pad);
         std::memset(static_cast<void*>(inc), 0, sizeof inc);
         grid.copy_grid_to_pad(b, pad);
-        const auto [lo, hi] = slice(grid, b, nc, ns);
+        bool added = false;
         const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
         for (std::uint32_t s = lo; s < hi; ++s) {
-          const auto [cp, p] = site(s);
-          const ShellContact& c = *cp;
+          const std::uint32_t g = order[s];
+          const ShellContact& c = *shells[table.shell(g)].contact;
+          const std::uint32_t p = table.local(g);
           const Vec3& G3 = c.G3[p];
           if (G3.squaredNorm() == 0) continue;
           const QuadraticWeights W(grid.grid_coord(c.x[p]));
@@ -198,8 +183,9 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
             inc[id].v[1] += dv[1];
             inc[id].v[2] += dv[2];
           });
+          added = true;
         }
-        grid.add_pad_to_grid(b, inc);
+        if (added) grid.add_pad_to_grid(b, inc);
       },
       serial);
 }
