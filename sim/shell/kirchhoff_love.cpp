@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <utility>
 
 #include "sim/core/check.h"
@@ -97,6 +98,8 @@ KirchhoffLoveShellT<T>::KirchhoffLoveShellT(std::vector<BasisPoint> points,
     reset_plastic_state();
   }
   build_gather_map();
+  if constexpr (std::is_same_v<T, float>)
+    patches_ = kl::build_patches(begin_, ctrl_, coef_, num_ctrl_);
 }
 
 template <class T>
@@ -307,7 +310,8 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
   // writes every one). The object keeps the array between calls (a fresh one per call, 36 MB
   // on a 100k-point sheet, cost its page faults every time: a third of a force
   // evaluation); a call that finds it in use by another thread takes its own.
-  const std::size_t ne = slot_.size();
+  const bool patched = this->patched();
+  const std::size_t ne = patched ? patches_.num_entries() : slot_.size();
   std::vector<T> own;
   const bool shared = forces && !scratch_.busy.test_and_set(std::memory_order_acquire);
   std::vector<T>& entry_scratch = shared ? scratch_.shares : own;
@@ -320,10 +324,20 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
   } release{shared ? &scratch_.busy : nullptr};
   T* const fe = forces ? entry_scratch.data() : nullptr;
   // Per chunk: total and membrane energy.
+  // (On patches, chunks of kPointGrain points' worth of patches.)
+  const std::size_t n = patched ? patches_.num_patches() : nq;
+  const std::size_t grain = patched ? kPointGrain / std::size_t(patches_.points) : kPointGrain;
   const std::vector<std::array<double, 2>> parts =
-      chunk_parts(nq, kPointGrain, serial, std::array<double, 2>{0.0, 0.0},
+      chunk_parts(n, std::max<std::size_t>(grain, 1), serial, std::array<double, 2>{0.0, 0.0},
                   [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
                     double et = 0.0, em = 0.0;
+                    if constexpr (std::is_same_v<T, float>) {
+                      if (patched) {
+                        eval_patch_range(b, e - b, x, fe, et, membrane ? &em : nullptr);
+                        part = {et, em};
+                        return;
+                      }
+                    }
                     eval_points(b, e - b, x, fe, et, membrane ? &em : nullptr);
                     part = {et, em};
                   });
@@ -338,9 +352,10 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
     parallel_for(
         num_ctrl_, kGatherGrain,
         [&](std::size_t b, std::size_t e) {
+          const std::vector<std::size_t>& start = patched ? patches_.gather_begin : gather_begin_;
           for (std::size_t j = b; j < e; ++j) {
             Vec3T f = Vec3T::Zero();
-            for (std::size_t i = gather_begin_[j]; i < gather_begin_[j + 1]; ++i)
+            for (std::size_t i = start[j]; i < start[j + 1]; ++i)
               for (int d = 0; d < 3; ++d) f[d] += fe[4 * i + d];
             forces[j] -= f;
           }

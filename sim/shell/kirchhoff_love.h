@@ -69,6 +69,7 @@
 
 #include "sim/core/types.h"
 #include "sim/scene/scene.h"
+#include "sim/shell/kl_patches.h"
 
 #if __has_include("sim/shell/loop_basis.h")
 #include "sim/shell/loop_basis.h"
@@ -90,6 +91,7 @@ namespace shellmpm {
 namespace kl {
 template <class T>
 struct PointKinematics;  // sim/shell/kl_kinematics.h
+struct BatchData;        // sim/shell/kl_batch.h
 }  // namespace kl
 
 template <class T>
@@ -169,6 +171,11 @@ class KirchhoffLoveShellT {
   /// Stretch limit s_l and stiffening coefficient k [Pa] of psi_s = k sum (s_a - s_l)_+^2.
   T stretch_limit() const { return stiffening_.limit; }
   T stretch_stiffness() const { return stiffening_.k; }
+  /// Whether forces run on patches (sim/shell/kl_patches.h: float, points in runs sharing
+  /// their control points); use_patches(false) makes them run point by point (the same
+  /// energy and point adjoints, force shares summed in another order: for comparisons).
+  bool patched() const { return !patches_.empty() && use_patches_; }
+  void use_patches(bool on) { use_patches_ = on; }
   /// Rest area of the shell sum_q w_q |abar_1 x abar_2| [m^2].
   double rest_area() const { return rest_area_; }
 
@@ -196,6 +203,13 @@ class KirchhoffLoveShellT {
   /// register (SSE, AVX2, AVX-512), with the same bits on each.
   void eval_points(std::size_t q0, std::size_t n, const Vec3T* x, T* fe, double& e_total,
                    double* e_membrane) const;
+  /// The float kernel's view of the arrays (sim/shell/kl_batch.cpp).
+  kl::BatchData batch_data() const;
+  /// eval_points for the patches at positions i0 .. i0 + n - 1 of patches_.order (their
+  /// points' energies added in that order, point by point), each patch entry's force share
+  /// at its slot in the patches' gather order. Float only (sim/shell/kl_batch.cpp).
+  void eval_patch_range(std::size_t i0, std::size_t n, const Vec3T* x, T* fe, double& e_total,
+                        double* e_membrane) const;
   /// From point q's adjoints G (15 values), writes each of its entries' dE/dx share (3
   /// values and a zero, so that one SSE store writes a share) at the entry's slot in gather
   /// order: fe[4 slot_[e] ..].
@@ -227,6 +241,8 @@ class KirchhoffLoveShellT {
   // entry e's.
   std::vector<std::size_t> gather_begin_;
   std::vector<std::uint32_t> slot_;
+  kl::Patches patches_;  // float only; empty where the points form no patches
+  bool use_patches_ = true;
   // energy()'s per-entry force shares (4 per entry), kept between calls; busy marks it in
   // use (a concurrent call takes its own). A copy of the object starts without one.
   struct ForceScratch {
@@ -244,6 +260,12 @@ template <>
 void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, const Vec3T* x,
                                              float* fe, double& e_total, double* e_membrane) const;
 
+template <>
+kl::BatchData KirchhoffLoveShellT<float>::batch_data() const;
+template <>
+void KirchhoffLoveShellT<float>::eval_patch_range(std::size_t i0, std::size_t n, const Vec3T* x,
+                                                  float* fe, double& e_total,
+                                                  double* e_membrane) const;
 using KirchhoffLoveShell = KirchhoffLoveShellT<Real>;
 
 extern template class KirchhoffLoveShellT<float>;

@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "sim/shell/kl_patches.h"
+
 namespace shellmpm::kl {
 
 /// A shell's per-point and per-entry arrays as the kernel reads them
@@ -35,5 +37,30 @@ void eval_batch_avx2(const BatchData& d, std::size_t q0, std::size_t n, const fl
                      float* energy, float* a12);
 void eval_batch_avx512(const BatchData& d, std::size_t q0, std::size_t n, const float* x, float* fe,
                        float* energy, float* a12);
+
+/// A shell's patches (kl_patches.h) as the patch kernel reads them.
+struct PatchData {
+  int points;
+  const std::uint32_t* order;
+  const std::uint32_t* pattern;
+  const std::uint32_t* begin;
+  const int* ctrl;
+  const std::uint32_t* slot;
+  const std::uint32_t* pattern_size;
+  const std::uint32_t* pattern_coef;
+  const float* coefs;
+};
+
+/// Patches p.order[i0 .. i0 + n - 1]: energy[(i - i0) P + k] the energy of point k of the
+/// patch at position i; where fe is not null, each patch entry's force share (x, y, z, 0) at
+/// fe[4 slot[e]]; where a12 is not null, that point's a_1 and a_2 at a12[6 ((i - i0) P + k)].
+using PatchFn = void (*)(const BatchData& d, const PatchData& p, std::size_t i0, std::size_t n,
+                         const float* x, float* fe, float* energy, float* a12);
+void eval_patches_sse(const BatchData& d, const PatchData& p, std::size_t i0, std::size_t n,
+                      const float* x, float* fe, float* energy, float* a12);
+void eval_patches_avx2(const BatchData& d, const PatchData& p, std::size_t i0, std::size_t n,
+                       const float* x, float* fe, float* energy, float* a12);
+void eval_patches_avx512(const BatchData& d, const PatchData& p, std::size_t i0, std::size_t n,
+                         const float* x, float* fe, float* energy, float* a12);
 
 }  // namespace shellmpm::kl

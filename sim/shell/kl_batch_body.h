@@ -22,6 +22,7 @@
 
 #include "sim/shell/kl_batch.h"
 #include "sim/shell/kl_lanes.h"
+#include "sim/shell/kl_patches.h"
 #include "sim/shell/laminate_energy.h"
 
 namespace shellmpm::kl {
@@ -116,6 +117,103 @@ template <class F>
   return psi;
 }
 
+/// Adjoints (x, y, z, 0) of lanes' five vectors, one SSE register per lane:
+/// G[i][j] = out[i] of lane j (a 4x4 transpose per group of four lanes).
+template <class F>
+[[gnu::always_inline]] inline void transpose_out(const V3<F>* const (&out)[5],
+                                                 __m128 (&G)[5][lanes::kLanes<F>]) {
+  constexpr int W = lanes::kLanes<F>;
+  for (int i = 0; i < 5; ++i)
+    for (int g = 0; g < W / 4; ++g) {
+      __m128 r0 = part(out[i]->x, g), r1 = part(out[i]->y, g), r2 = part(out[i]->z, g),
+             r3 = _mm_setzero_ps();
+      _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+      G[i][4 * g] = r0;
+      G[i][4 * g + 1] = r1;
+      G[i][4 * g + 2] = r2;
+      G[i][4 * g + 3] = r3;
+    }
+}
+
+/// One point per lane (lane j: point qs[j]) from its a_1, a_2, a_11, a_12, a_22 (av):
+/// the energy, and where `adjoints` the adjoints of av in G (eval_kinematics).
+template <class F>
+[[gnu::always_inline]] inline F point_lanes(const BatchData& d, const std::size_t* qs,
+                                            const V3<F> (&av)[5], bool adjoints, V3<F> (&G)[5]) {
+  constexpr int W = lanes::kLanes<F>;
+  const int nl = d.num_layers;
+  const V3<F> a1 = av[0], a2 = av[1], a11 = av[2], a12 = av[3], a22 = av[4];
+  // Kinematics (kl_kinematics.h, compute_kinematics).
+  const V3<F> nrm = cross(a1, a2);
+  const F inv_l = splat<F>(1.0f) / vsqrt(dot(nrm, nrm));
+  const V3<F> a3 = inv_l * nrm;
+  const V3<F> t1 = inv_l * (cross(a11, a2) + cross(a1, a12));
+  const V3<F> t2 = inv_l * (cross(a12, a2) + cross(a1, a22));
+  const V3<F> v1 = t1 - dot(a3, t1) * a3;
+  const V3<F> v2 = t2 - dot(a3, t2) * a3;
+  F area;
+  for (int j = 0; j < W; ++j) area[j] = d.area[qs[j]];
+  const V3<F> zero{splat<F>(0.0f), splat<F>(0.0f), splat<F>(0.0f)};
+  V3<F> Ga1 = zero, Ga2 = zero, Gv1 = zero, Gv2 = zero;
+  F energy = splat<F>(0.0f);
+  for (int l = 0; l < nl; ++l) {
+    const F xi3 = splat<F>(d.layer_xi3[l]);
+    const V3<F> g1 = a1 + xi3 * v1, g2 = a2 + xi3 * v2;
+    const F m11 = dot(g1, g1), m12 = dot(g1, g2), m22 = dot(g2, g2);
+    __m128 rows[W];
+    F Bp[4];
+    for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.B[4 * (qs[j] * nl + l)]);
+    transpose_in<F>(rows, Bp);
+    if (d.fp_inv) {
+      F Fi[4];
+      for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.fp_inv[4 * (qs[j] * nl + l)]);
+      transpose_in<F>(rows, Fi);
+      const F B0 = Bp[0], B1 = Bp[1], B2 = Bp[2], B3 = Bp[3];
+      Bp[0] = B0 * Fi[0] + B1 * Fi[2];
+      Bp[1] = B0 * Fi[1] + B1 * Fi[3];
+      Bp[2] = B2 * Fi[0] + B3 * Fi[2];
+      Bp[3] = B2 * Fi[1] + B3 * Fi[3];
+    }
+    const F V = area * splat<F>(d.layer_w[l]);
+    F S[3];
+    energy = energy + V * layer_psi_lanes<F>(d, Bp, m11, m12, m22, S);
+    if (adjoints) {
+      const F s = splat<F>(2.0f) * V;
+      const V3<F> dg1 = s * (S[0] * g1 + S[1] * g2);
+      const V3<F> dg2 = s * (S[1] * g1 + S[2] * g2);
+      Ga1 = Ga1 + dg1;
+      Ga2 = Ga2 + dg2;
+      Gv1 = Gv1 + xi3 * dg1;
+      Gv2 = Gv2 + xi3 * dg2;
+    }
+  }
+  if (!adjoints) return energy;
+  // Backpropagation through v_a = (I - a3 a3^T) m_a / l (eval_kinematics).
+  const V3<F> PG1 = Gv1 - dot(a3, Gv1) * a3, PG2 = Gv2 - dot(a3, Gv2) * a3;
+  const V3<F> cm1 = inv_l * PG1, cm2 = inv_l * PG2;
+  const V3<F> sum = dot(a3, t1) * PG1 + dot(a3, Gv1) * v1 + dot(Gv1, v1) * a3 + dot(a3, t2) * PG2 +
+                    dot(a3, Gv2) * v2 + dot(Gv2, v2) * a3;
+  const V3<F> cn = (splat<F>(0.0f) - inv_l) * sum;
+  G[0] = Ga1 + (cross(a12, cm1) + cross(a22, cm2) + cross(a2, cn));
+  G[1] = Ga2 + (cross(cm1, a11) + cross(cm2, a12) + cross(cn, a1));
+  G[2] = cross(a2, cm1);
+  G[3] = cross(cm1, a1) + cross(a2, cm2);
+  G[4] = cross(cm2, a1);
+  return energy;
+}
+
+/// Writes lane j's a_1 and a_2 at o[6 j ..] for j < cnt.
+template <class F>
+[[gnu::always_inline]] inline void store_a12(const V3<F> (&av)[5], int cnt, std::size_t stride,
+                                             float* o) {
+  for (int j = 0; j < cnt; ++j) {
+    float* p = o + stride * std::size_t(j);
+    p[0] = av[0].x[j], p[1] = av[0].y[j], p[2] = av[0].z[j];
+    p[3] = av[1].x[j], p[4] = av[1].y[j], p[5] = av[1].z[j];
+  }
+}
+
+/// Per-point path: points q0 .. q0 + n - 1, W at a time.
 template <int W>
 [[gnu::always_inline]] inline void eval_batch(const BatchData& d, std::size_t q0, std::size_t n,
                                               const float* x, float* fe, float* energy_out,
@@ -125,7 +223,6 @@ template <int W>
   const int* const ctrl = d.ctrl;
   const float* const coef = d.coef;
   const std::uint32_t* const slot = d.slot;
-  const int nl = d.num_layers;
   for (std::size_t b = q0; b < q0 + n; b += W) {
     const int cnt = static_cast<int>(std::min<std::size_t>(W, q0 + n - b));
     // Lane j: point b + j; lanes past the end repeat the last point (results unused).
@@ -155,86 +252,15 @@ template <int W>
       transpose_in<F>(acc[i], t);
       av[i] = V3<F>{t[0], t[1], t[2]};
     }
-    const V3<F> a1 = av[0], a2 = av[1], a11 = av[2], a12 = av[3], a22 = av[4];
-    // Kinematics (kl_kinematics.h, compute_kinematics).
-    const V3<F> nrm = cross(a1, a2);
-    const F inv_l = splat<F>(1.0f) / vsqrt(dot(nrm, nrm));
-    const V3<F> a3 = inv_l * nrm;
-    const V3<F> t1 = inv_l * (cross(a11, a2) + cross(a1, a12));
-    const V3<F> t2 = inv_l * (cross(a12, a2) + cross(a1, a22));
-    const V3<F> v1 = t1 - dot(a3, t1) * a3;
-    const V3<F> v2 = t2 - dot(a3, t2) * a3;
-    F area;
-    for (int j = 0; j < W; ++j) area[j] = d.area[qs[j]];
-    const V3<F> zero{splat<F>(0.0f), splat<F>(0.0f), splat<F>(0.0f)};
-    V3<F> Ga1 = zero, Ga2 = zero, Gv1 = zero, Gv2 = zero;
-    F energy = splat<F>(0.0f);
-    for (int l = 0; l < nl; ++l) {
-      const F xi3 = splat<F>(d.layer_xi3[l]);
-      const V3<F> g1 = a1 + xi3 * v1, g2 = a2 + xi3 * v2;
-      const F m11 = dot(g1, g1), m12 = dot(g1, g2), m22 = dot(g2, g2);
-      __m128 rows[W];
-      F Bp[4];
-      for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.B[4 * (qs[j] * nl + l)]);
-      transpose_in<F>(rows, Bp);
-      if (d.fp_inv) {
-        F Fi[4];
-        for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.fp_inv[4 * (qs[j] * nl + l)]);
-        transpose_in<F>(rows, Fi);
-        const F B0 = Bp[0], B1 = Bp[1], B2 = Bp[2], B3 = Bp[3];
-        Bp[0] = B0 * Fi[0] + B1 * Fi[2];
-        Bp[1] = B0 * Fi[1] + B1 * Fi[3];
-        Bp[2] = B2 * Fi[0] + B3 * Fi[2];
-        Bp[3] = B2 * Fi[1] + B3 * Fi[3];
-      }
-      const F V = area * splat<F>(d.layer_w[l]);
-      F S[3];
-      energy = energy + V * layer_psi_lanes<F>(d, Bp, m11, m12, m22, S);
-      if (fe) {
-        const F s = splat<F>(2.0f) * V;
-        const V3<F> dg1 = s * (S[0] * g1 + S[1] * g2);
-        const V3<F> dg2 = s * (S[1] * g1 + S[2] * g2);
-        Ga1 = Ga1 + dg1;
-        Ga2 = Ga2 + dg2;
-        Gv1 = Gv1 + xi3 * dg1;
-        Gv2 = Gv2 + xi3 * dg2;
-      }
-    }
-    for (int j = 0; j < cnt; ++j) {
-      energy_out[b - q0 + std::size_t(j)] = energy[j];
-      if (a12_out) {
-        float* o = a12_out + 6 * (b - q0 + std::size_t(j));
-        o[0] = a1.x[j], o[1] = a1.y[j], o[2] = a1.z[j];
-        o[3] = a2.x[j], o[4] = a2.y[j], o[5] = a2.z[j];
-      }
-    }
+    V3<F> out[5];
+    const F energy = point_lanes<F>(d, qs, av, fe != nullptr, out);
+    for (int j = 0; j < cnt; ++j) energy_out[b - q0 + std::size_t(j)] = energy[j];
+    if (a12_out) store_a12<F>(av, cnt, 6, a12_out + 6 * (b - q0));
     if (!fe) continue;
-    // Backpropagation through v_a = (I - a3 a3^T) m_a / l (eval_kinematics).
-    const V3<F> PG1 = Gv1 - dot(a3, Gv1) * a3, PG2 = Gv2 - dot(a3, Gv2) * a3;
-    const V3<F> cm1 = inv_l * PG1, cm2 = inv_l * PG2;
-    const V3<F> sum = dot(a3, t1) * PG1 + dot(a3, Gv1) * v1 + dot(Gv1, v1) * a3 +
-                      dot(a3, t2) * PG2 + dot(a3, Gv2) * v2 + dot(Gv2, v2) * a3;
-    const V3<F> cn = (splat<F>(0.0f) - inv_l) * sum;
-    Ga1 = Ga1 + (cross(a12, cm1) + cross(a22, cm2) + cross(a2, cn));
-    Ga2 = Ga2 + (cross(cm1, a11) + cross(cm2, a12) + cross(cn, a1));
-    const V3<F> G11 = cross(a2, cm1);
-    const V3<F> G12 = cross(cm1, a1) + cross(a2, cm2);
-    const V3<F> G22 = cross(cm2, a1);
-    const V3<F>* out[5] = {&Ga1, &Ga2, &G11, &G12, &G22};
-    // Per point j the five adjoints as (x, y, z, 0) (a 4x4 transpose per group of four
-    // lanes), then each entry's share c0 Ga1 + c1 Ga2 + c2 G11 + c3 G12 + c4 G22 as in
-    // entry_shares, one SSE store per entry.
+    // Each entry's share c0 Ga1 + c1 Ga2 + c2 G11 + c3 G12 + c4 G22 as in entry_shares,
+    // one SSE store per entry.
     __m128 G[5][W];
-    for (int i = 0; i < 5; ++i)
-      for (int g = 0; g < W / 4; ++g) {
-        __m128 r0 = part(out[i]->x, g), r1 = part(out[i]->y, g), r2 = part(out[i]->z, g),
-               r3 = _mm_setzero_ps();
-        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-        G[i][4 * g] = r0;
-        G[i][4 * g + 1] = r1;
-        G[i][4 * g + 2] = r2;
-        G[i][4 * g + 3] = r3;
-      }
+    transpose_out<F>({&out[0], &out[1], &out[2], &out[3], &out[4]}, G);
     for (int j = 0; j < cnt; ++j)
       for (std::size_t e = begin[qs[j]], e1 = begin[qs[j] + 1]; e < e1; ++e) {
         const float* c = &coef[5 * e];
@@ -249,12 +275,87 @@ template <int W>
   }
 }
 
+/// Patch path (sim/shell/kl_patches.h): patches p.order[i0 .. i0 + n - 1], one per lane,
+/// W of one pattern at a time; energy_out[(i - i0) P + k] is point k of the patch at
+/// position i. A point's a_alpha, a_alphabeta are summed over its control points in the
+/// per-point path's order with the same coefficients, so they and the point's energy and
+/// adjoints are the same bits on both paths; a share sums the patch's points in order.
+template <int W>
+[[gnu::always_inline]] inline void eval_patches(const BatchData& d, const PatchData& p,
+                                                std::size_t i0, std::size_t n, const float* x,
+                                                float* fe, float* energy_out, float* a12_out) {
+  using F = typename lanes::Width<W>::F;
+  const int P = p.points;
+  for (std::size_t i = i0; i < i0 + n;) {
+    const std::uint32_t pat = p.pattern[p.order[i]];
+    int cnt = 1;
+    while (cnt < W && i + std::size_t(cnt) < i0 + n && p.pattern[p.order[i + cnt]] == pat) ++cnt;
+    // Lane j: patch order[i + j]; lanes past cnt repeat the last (results unused).
+    std::uint32_t g[W];
+    for (int j = 0; j < W; ++j) g[j] = p.order[i + std::size_t(std::min(j, cnt - 1))];
+    const int m = static_cast<int>(p.pattern_size[pat]);
+    const float* const C = p.coefs + p.pattern_coef[pat];  // [k][c][5]
+    // Control positions, one patch per lane, relative to the first.
+    V3<F> dX[Patches::kMaxCtrl];
+    for (int c = 0; c < m; ++c) {
+      __m128 rows[W];
+      for (int j = 0; j < W; ++j) rows[j] = load3(x + 3 * std::size_t(p.ctrl[p.begin[g[j]] + c]));
+      F t[4];
+      transpose_in<F>(rows, t);
+      dX[c] = V3<F>{t[0], t[1], t[2]};
+      if (c > 0) dX[c] = dX[c] - dX[0];
+    }
+    V3<F> G[Patches::kMaxPoints][5];
+    for (int k = 0; k < P; ++k) {
+      const V3<F> zero{splat<F>(0.0f), splat<F>(0.0f), splat<F>(0.0f)};
+      V3<F> av[5] = {zero, zero, zero, zero, zero};
+      for (int c = 1; c < m; ++c) {
+        const float* ck = C + 5 * (std::size_t(k) * m + c);
+        for (int a = 0; a < 5; ++a) av[a] = av[a] + splat<F>(ck[a]) * dX[c];
+      }
+      std::size_t qs[W];
+      for (int j = 0; j < W; ++j) qs[j] = std::size_t(g[j]) * P + k;
+      const F energy = point_lanes<F>(d, qs, av, fe != nullptr, G[k]);
+      const std::size_t o = (i - i0) * P + k;
+      for (int j = 0; j < cnt; ++j) energy_out[o + std::size_t(j) * P] = energy[j];
+      if (a12_out) store_a12<F>(av, cnt, 6 * std::size_t(P), a12_out + 6 * o);
+    }
+    if (fe) {
+      // Per control point c: sum over the points k of c0 Ga1 + c1 Ga2 + c2 G11 + c3 G12 +
+      // c4 G22, then one SSE store per lane.
+      for (int c = 0; c < m; ++c) {
+        const auto share = [&](int k) {
+          const float* ck = C + 5 * (std::size_t(k) * m + c);
+          return splat<F>(ck[0]) * G[k][0] + splat<F>(ck[1]) * G[k][1] + splat<F>(ck[2]) * G[k][2] +
+                 splat<F>(ck[3]) * G[k][3] + splat<F>(ck[4]) * G[k][4];
+        };
+        V3<F> s = share(0);
+        for (int k = 1; k < P; ++k) s = s + share(k);
+        for (int q = 0; q < W / 4; ++q) {
+          __m128 r0 = part(s.x, q), r1 = part(s.y, q), r2 = part(s.z, q), r3 = _mm_setzero_ps();
+          _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+          const __m128 r[4] = {r0, r1, r2, r3};
+          for (int j = 0; j < 4 && 4 * q + j < cnt; ++j)
+            _mm_storeu_ps(&fe[4 * std::size_t(p.slot[p.begin[g[4 * q + j]] + c])], r[j]);
+        }
+      }
+    }
+    i += std::size_t(cnt);
+  }
+}
+
 }  // namespace
 
 __attribute__((flatten)) void SHELLMPM_KL_BATCH_ENTRY(const BatchData& d, std::size_t q0,
                                                       std::size_t n, const float* x, float* fe,
                                                       float* energy, float* a12) {
   eval_batch<SHELLMPM_KL_BATCH_WIDTH>(d, q0, n, x, fe, energy, a12);
+}
+
+__attribute__((flatten)) void SHELLMPM_KL_PATCH_ENTRY(const BatchData& d, const PatchData& p,
+                                                      std::size_t i0, std::size_t n, const float* x,
+                                                      float* fe, float* energy, float* a12) {
+  eval_patches<SHELLMPM_KL_BATCH_WIDTH>(d, p, i0, n, x, fe, energy, a12);
 }
 
 }  // namespace shellmpm::kl

@@ -238,12 +238,19 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
   const double object = V * (2 * kVec3 + R + 24 + 1 + 4) + 12 * T;
   const double basis = 12 * T + 8 * V + 12 * T + 12 * T + V;
   // Per entry its control point and gather slot (4 + 4), coefficients and value (6 R).
+  // In float, the faces' patches (sim/shell/kl_patches.h): per (face, control point) its
+  // control point and slot, per face its start, pattern and place in the order, per
+  // control point its gather start (the patterns' tables are a few kB).
+  const bool patched = sizeof(Real) == 4;
+  const double face_entries = T * S;
+  const double patches = patched ? face_entries * 8 + T * 12 + 8 * V : 0;
   const double kl = entries * (8 + 6 * R) + qp * (8 + R + 4 * R * layers + 4 * R) +
-                    (m.yield_stress > 0 ? qp * 4 * R * layers : 0) + 8 * V;
+                    (m.yield_stress > 0 ? qp * 4 * R * layers : 0) + 8 * V + patches;
   const double limit = limit_mesh_bytes(Vout, Tout, S, c.has_uvs);
   // + the force buffer, and the Kirchhoff-Love force shares kept between steps (4 scalars
-  // per entry).
-  const double persistent = object + basis + kl + limit + V * kVec3 + 4 * R * entries;
+  // per entry, per face entry on patches).
+  const double persistent =
+      object + basis + kl + limit + V * kVec3 + 4 * R * (patched ? face_entries : entries);
   // While the Kirchhoff-Love data is built: every quadrature point's BasisPoint (seven
   // vectors grown by push_back), the weights and the rest mesh passed in.
   const double cap = grown(S);

@@ -11,6 +11,7 @@
 #include "sim/mpm/stress_batch.h"
 #include "sim/shell/kirchhoff_love.h"
 #include "sim/shell/kl_lanes.h"
+#include "sim/shell/shell_object.h"
 #include "tests/support/bezier_test_basis.h"
 
 using namespace shellmpm;
@@ -149,6 +150,11 @@ TEST_CASE("the float KL kernel gives the same bits on every instruction set", "[
     ~Restore() { set_simd_level(saved); }
   } restore;
   INFO("this machine: " << simd_name(simd_supported()));
+  // On patches (18 faces of 7 points: part registers at every width) and point by point.
+  REQUIRE(shf.patched());
+  const bool patches = GENERATE(true, false);
+  shf.use_patches(patches);
+  INFO("patches " << patches);
   std::vector<Eigen::Vector3f> ref;
   KirchhoffLoveShellT<float>::Energy eref{};
   for (int level = 0; level <= static_cast<int>(simd_supported()); ++level) {
@@ -166,4 +172,60 @@ TEST_CASE("the float KL kernel gives the same bits on every instruction set", "[
     CHECK(std::memcmp(&e.membrane, &eref.membrane, sizeof e.membrane) == 0);
     CHECK(std::memcmp(f.data(), ref.data(), f.size() * sizeof(Eigen::Vector3f)) == 0);
   }
+}
+
+TEST_CASE(
+    "KL patches: a Loop sheet's faces form them; the same energy as point by point and the "
+    "forces to rounding; points in uneven runs go point by point",
+    "[kl]") {
+  // A Loop sheet with the default 3-point rule: one patch per face, a handful of patterns.
+  ShellDesc sd;
+  sd.kind = ShellDesc::Kind::Sheet;
+  sd.size[0] = sd.size[1] = 1.0;
+  sd.resolution[0] = sd.resolution[1] = 6;
+  ShellMaterialDesc mat = metal();
+  const ShellObject sheet(sd, mat, build_shell_rest_mesh(sd));
+  CHECK(sheet.kl().patched());
+
+  // Bezier patches (7 points each), plastic, stretched past the limit, bent.
+  const BezierShell s = shellmpm_test::make_bezier_grid(3, 3, 7);
+  const std::vector<Eigen::Vector3d> rest =
+      shellmpm_test::interpolate(s, [](const Eigen::Vector2d& uv) {
+        return Eigen::Vector3d(uv.x(), uv.y(), 0.2 * std::sin(2.0 * uv.x()) * uv.y());
+      });
+  KirchhoffLoveShellT<float> shf(s.points, s.weights, rest, mat, 3);
+  REQUIRE(shf.patched());
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<float> pf = shf.plastic_state();
+  for (float& v : pf) v += 0.05f * u(rng);
+  shf.set_plastic_state(pf);
+  std::vector<Eigen::Vector3f> x(rest.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    Eigen::Vector3d p = rest[i];
+    if (p.x() > 0.5) p.x() = 0.5 + 1.9 * (p.x() - 0.5);
+    p.z() += 0.1 * p.x() * p.x() + 0.01 * u(rng);
+    x[i] = p.cast<float>();
+  }
+  std::vector<Eigen::Vector3f> fp(x.size(), Eigen::Vector3f::Zero()), fq = fp;
+  const auto ep = shf.energy(x.data(), fp.data(), false, true);
+  shf.use_patches(false);
+  CHECK_FALSE(shf.patched());
+  const auto eq = shf.energy(x.data(), fq.data(), false, true);
+  // The same float energy per point, summed in other chunks (in double).
+  CHECK(ep.total == Approx(eq.total).epsilon(1e-6));
+  CHECK(ep.membrane == Approx(eq.membrane).epsilon(1e-6));
+  float scale = 0, worst = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    scale = std::max(scale, fq[i].norm());
+    worst = std::max(worst, (fp[i] - fq[i]).norm());
+  }
+  REQUIRE(scale > 0);
+  CHECK(worst < 1e-5f * scale);
+
+  // Dropping the last point leaves a run of 6: no patches, and the same first points.
+  std::vector<BasisPoint> pts(s.points.begin(), s.points.end() - 1);
+  std::vector<double> w(s.weights.begin(), s.weights.end() - 1);
+  const KirchhoffLoveShellT<float> uneven(pts, w, rest, mat, 3);
+  CHECK_FALSE(uneven.patched());
 }
