@@ -95,6 +95,10 @@ int main(int argc, char** argv) {
     }
     std::printf("  per step:");
     for (const auto& [g, v] : groups) std::printf("  %s %.1f ms", g.c_str(), 1e3 * v / fs.substeps);
+    std::printf("\n  stages:");
+    for (const auto& [name, v] : fs.stage_seconds)
+      if (name != "reorder" && name != "integrity_frame" && v > 0)
+        std::printf("  %s %.1f", name.c_str(), 1e3 * v / fs.substeps);
     std::printf("\n");
   }
   return 0;

@@ -118,8 +118,16 @@ void ShellContact::reset(const Vec3* ctrl, bool serial) {
 
 double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
   const double e = ordered_reduce(num_sites(), kGrain, serial, 0.0, [&](std::size_t p) {
-    Vec3 a1, a2;
-    tangents(ctrl, p, a1, a2);
+    // Position and tangents in one pass over the stencil (as update_positions, tangents).
+    const Vec3 ref = ctrl[idx[off[p]]];
+    Vec3 d = Vec3::Zero(), a1 = Vec3::Zero(), a2 = Vec3::Zero();
+    for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
+      const Vec3 dk = ctrl[idx[k]] - ref;
+      d += N[k] * dk;
+      a1 += N1[k] * dk;
+      a2 += N2[k] * dk;
+    }
+    x[p] = ref + d;
     Mat3 G;
     const Real psi = contact_gradient<Real>(a1, a2, a3e[p], params_, &G);
     const Real V = volume[p];

@@ -36,9 +36,10 @@ class ShellContact {
 
   /// Site positions x from the control points.
   void update_positions(const Vec3* ctrl, bool serial);
-  /// Contact energy sum V psi [J]. Stores dpsi/da3E per site in `G3` (for the grid's normal
-  /// force) and adds the tangential part, f_j = -sum_p V_p sum_beta dN_j/dxi_beta
-  /// dpsi/da_beta, to the control-point forces f (deterministic gather per point).
+  /// Contact energy sum V psi [J]. Updates the site positions x (update_positions), stores
+  /// dpsi/da3E per site in `G3` (for the grid's normal force) and adds the tangential part, f_j =
+  /// -sum_p V_p sum_beta dN_j/dxi_beta dpsi/da_beta, to the control-point forces f (deterministic
+  /// gather per point).
   double forces(const Vec3* ctrl, Vec3* f, bool serial);
   /// Energy only [J].
   double energy(const Vec3* ctrl, bool serial) const;

@@ -143,7 +143,6 @@ void SparseGrid::bin_grid_blocks(bool serial) {
       gblock_src[g][o] = (sx < 0 || sy < 0 || sz < 0) ? -1 : phash_.find(pack_block(sx, sy, sz));
     }
   }
-  if (!pblock_buf.empty()) pblock_buf.resize(nb);
   // Columns: blocks sorted by (colour, x, y, z).
   column_blocks.resize(nb);
   for (std::size_t b = 0; b < nb; ++b) column_blocks[b] = static_cast<std::uint32_t>(b);
@@ -193,32 +192,11 @@ void SparseGrid::for_each_block_by_colour(const std::function<void(std::size_t)>
 }
 
 void SparseGrid::add_pad_to_grid(std::size_t b, const GridNode* pad) {
-  for_each_pad_node(b,
-                    [&](int g, int bn, int pn) { add_node(gblock_nodes[g][bn], pad[pn], true); });
+  for_each_pad_node(b, [&](int g, int bn, int pn) { add_node(gblock_nodes[g][bn], pad[pn]); });
 }
 
 void SparseGrid::copy_grid_to_pad(std::size_t b, GridNode* pad) const {
   for_each_pad_node(b, [&](int g, int bn, int pn) { pad[pn] = gblock_nodes[g][bn]; });
-}
-
-void SparseGrid::gather(bool with_mass, bool serial) {
-  SHELLMPM_CHECK(pblock_buf.size() == pblock_key.size(), << "gather before ensure_buffers");
-  parallel_for_each(
-      gblock_key.size(), 4,
-      [&](std::size_t g) {
-        auto& nodes = gblock_nodes[g];
-        for_each_buffer_node(g, [&](int dn, std::size_t src, int sn) {
-          add_node(nodes[dn], pblock_buf[src][sn], with_mass);
-        });
-      },
-      serial);
-}
-
-void SparseGrid::scatter_grid_to_buffers(bool serial) {
-  ensure_buffers();
-  parallel_for_each(
-      pblock_key.size(), 4, [&](std::size_t b) { copy_grid_to_pad(b, pblock_buf[b].data()); },
-      serial);
 }
 
 std::size_t SparseGrid::runs_bytes() const {
@@ -230,7 +208,6 @@ std::size_t SparseGrid::runs_bytes() const {
 std::size_t SparseGrid::bytes() const {
   return order_.capacity() * 4 + pblock_start.capacity() * 4 + pblock_key.capacity() * 8 +
          block_run_start.capacity() * 4 + block_runs.capacity() * 8 + pblock_nbr.capacity() * 32 +
-         pblock_buf.capacity() * sizeof(pblock_buf[0]) +
          (column_blocks.capacity() + column_start.capacity()) * 4 + gblock_key.capacity() * 8 +
          gblock_src.capacity() * 32 + gblock_nodes.capacity() * sizeof(gblock_nodes[0]) +
          phash_.bytes() + ghash_.bytes() + runs_bytes();

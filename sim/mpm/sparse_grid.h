@@ -2,17 +2,14 @@
 //
 // Determinism without atomics (house style 7): particles are binned by the block of
 // their lowest stencil node ("particle block"), whose stencils cover a padded 6x6x6 node
-// region. Two ways to sum the blocks into the grid, neither depending on how threads are
-// scheduled, so results are bit-identical for any thread count:
-// - by colour (the bulk transfers): columns of particle blocks along z whose x and y
-//   have the same parities are two blocks apart and their regions do not overlap; the
-//   four colours run one after the other, the columns of one colour in parallel, each
-//   block of a column in turn scattering into a thread's own padded buffer and adding it
-//   straight into the grid blocks;
-// - through kept buffers (points of several kinds sharing a block's buffer: shells): each
-//   particle block scatters into its own padded buffer (pblock_buf, allocated by
-//   ensure_buffers), and each grid block sums the buffers of the (at most eight) particle
-//   blocks that overlap it, always in the same order.
+// region. Blocks are summed by colour, which does not depend on how threads are
+// scheduled, so results are bit-identical for any thread count: columns of particle
+// blocks along z whose x and y have the same parities are two blocks apart and their
+// regions do not overlap; the four colours run one after the other, the columns of one
+// colour in parallel, each block of a column in turn scattering into a thread's own padded
+// buffer (its bulk particles, then its shell points) and adding it straight into the grid
+// blocks. (Per-body grids with buffers of their own, e.g. the shells' fold classes, sum
+// them per grid block with for_each_buffer_node, always in the same order.)
 #pragma once
 #include <algorithm>
 #include <array>
@@ -114,9 +111,6 @@ class SparseGrid {
   std::vector<std::array<std::uint32_t, 2>> block_runs;
   std::vector<std::uint64_t> pblock_key;       ///< packed block coordinate
   std::vector<std::array<int, 8>> pblock_nbr;  ///< grid block at key + (ox,oy,oz), o = 4ox+2oy+oz
-  /// Scatter/gather buffers, one per particle block: empty until ensure_buffers(), then
-  /// kept sized by bin().
-  std::vector<std::array<GridNode, kPadNodes>> pblock_buf;
   /// Particle blocks in columns along z (same x and y), each column ascending in z; the
   /// columns grouped by colour (x&1)<<1 | (y&1): column i is column_blocks[column_start[i]
   /// .. column_start[i+1]), the columns of colour c are colour_columns[c] .. [c+1].
@@ -169,10 +163,6 @@ class SparseGrid {
     }
   }
 
-  /// Allocates pblock_buf for the current particle blocks.
-  void ensure_buffers() {
-    if (pblock_buf.size() != pblock_key.size()) pblock_buf.resize(pblock_key.size());
-  }
   /// Calls f(b) for every particle block b: colour by colour, the columns of one colour in
   /// parallel, the blocks of a column in z order (columns of one colour cover disjoint
   /// nodes, so each block may add to the grid directly).
@@ -187,19 +177,10 @@ class SparseGrid {
   /// Copies the grid nodes that particle block b's padded region overlaps into pad.
   void copy_grid_to_pad(std::size_t b, GridNode* pad) const;
 
-  /// Sums every particle block's buffer into the grid blocks (fixed order).
-  void gather_buffers_to_grid(bool serial = false) { gather(true, serial); }
-  /// Adds every particle block buffer's v into the grid nodes' v (fixed order); the
-  /// buffers' m are ignored (velocity increments computed per block).
-  void gather_buffer_increments(bool serial = false) { gather(false, serial); }
-  /// Copies grid node values into each particle block's padded buffer.
-  void scatter_grid_to_buffers(bool serial = false);
-
  private:
-  void gather(bool with_mass, bool serial);
-  /// d += s (the mass too when with_mass).
-  static void add_node(GridNode& d, const GridNode& s, bool with_mass) {
-    if (with_mass) d.m += s.m;
+  /// d += s.
+  static void add_node(GridNode& d, const GridNode& s) {
+    d.m += s.m;
     d.v[0] += s.v[0];
     d.v[1] += s.v[1];
     d.v[2] += s.v[2];

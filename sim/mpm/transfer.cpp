@@ -82,20 +82,6 @@ void with_scheme(const TransferParams& tp, std::size_t b, GridNode* buf, Block&&
     block(b, buf, std::false_type());
 }
 
-/// For every particle block b in parallel, on its kept buffer: the bulk particles
-/// (block(b, buf, kMls)), then tp.others (the shells' points of the block).
-template <class Block>
-void each_block_buffer(SparseGrid& grid, const TransferParams& tp, Block&& block) {
-  parallel_for_each(
-      grid.num_particle_blocks(), 1,
-      [&](std::size_t b) {
-        GridNode* buf = grid.pblock_buf[b].data();
-        with_scheme(tp, b, buf, block);
-        tp.others(b, buf);
-      },
-      tp.serial);
-}
-
 /// A thread's padded buffer for the bulk-only transfers (no buffer per block is kept).
 GridNode* thread_pad() {
   alignas(64) thread_local std::array<GridNode, kPadNodes> pad;
@@ -108,39 +94,31 @@ void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferPar
   auto block = [&](std::size_t b, GridNode* buf, auto mls) {
     p2g_block<decltype(mls)::value>(p, grid, tp, b, buf);
   };
-  if (!tp.others) {
-    // Bulk particles only: colour by colour, each block straight into the grid.
-    grid.for_each_block_by_colour(
-        [&](std::size_t b) {
-          GridNode* pad = thread_pad();
-          with_scheme(tp, b, pad, block);
-          grid.add_pad_to_grid(b, pad);
-        },
-        tp.serial);
-    return;
-  }
-  grid.ensure_buffers();
-  each_block_buffer(grid, tp, block);
-  grid.gather_buffers_to_grid(tp.serial);
+  // Colour by colour, each block (its bulk particles, then tp.others: the shells' points)
+  // into a thread's padded buffer and from there straight into the grid.
+  grid.for_each_block_by_colour(
+      [&](std::size_t b) {
+        GridNode* pad = thread_pad();
+        with_scheme(tp, b, pad, block);
+        if (tp.others) tp.others(b, pad);
+        grid.add_pad_to_grid(b, pad);
+      },
+      tp.serial);
 }
 
 void grid_to_particles(ParticleSet& p, SparseGrid& grid, const TransferParams& tp) {
   auto block = [&](std::size_t b, GridNode* buf, auto mls) {
     g2p_block<decltype(mls)::value>(p, grid, tp, b, buf);
   };
-  if (!tp.others) {
-    parallel_for_each(
-        grid.num_particle_blocks(), 1,
-        [&](std::size_t b) {
-          GridNode* pad = thread_pad();
-          grid.copy_grid_to_pad(b, pad);
-          with_scheme(tp, b, pad, block);
-        },
-        tp.serial);
-    return;
-  }
-  grid.scatter_grid_to_buffers(tp.serial);
-  each_block_buffer(grid, tp, block);
+  parallel_for_each(
+      grid.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        GridNode* pad = thread_pad();
+        grid.copy_grid_to_pad(b, pad);
+        with_scheme(tp, b, pad, block);
+        if (tp.others) tp.others(b, pad);
+      },
+      tp.serial);
 }
 
 }  // namespace shellmpm

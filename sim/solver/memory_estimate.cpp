@@ -195,16 +195,14 @@ double limit_mesh_bytes(double nv, double nt, double support, bool uvs) {
 /// Grid arrays (SparseGrid) for `points` binned into pblocks / gblocks: per particle block
 /// its key, neighbours, start, column place and runs of points (a few, 24 bytes each with
 /// the binning's; the sources fill block by block), per grid
-/// block its 4^3 nodes, key and sources; both hash tables at load <= 1/2. `shells`: points
-/// other than bulk particles share the blocks, which then keep a 6^3 buffer each; `order`:
+/// block its 4^3 nodes, key and sources; both hash tables at load <= 1/2 (the transfers
+/// scatter through a thread's 6^3 buffer, colour by colour: no buffer per block). `order`:
 /// the grid keeps the sort order (4 bytes a point: shells or the implicit solve); `nodes`:
 /// the grid blocks have nodes (not the per-shell fields' binning grids).
-double grid_bytes(double points, double pblocks, double gblocks, bool shells, bool order,
-                  bool nodes = true) {
+double grid_bytes(double points, double pblocks, double gblocks, bool order, bool nodes = true) {
   constexpr double kNode = 4 * R;  // GridNode: m, v[3]
   const double hash = 16 * 3;      // 12 + 4 bytes a slot, 2 to 4 slots an entry
-  return (order ? 4 : 0) * points +
-         pblocks * ((shells ? 216 * kNode : 0) + 8 + 32 + 4 + 8 + 4 * 24 + hash) +
+  return (order ? 4 : 0) * points + pblocks * (8 + 32 + 4 + 8 + 4 * 24 + hash) +
          gblocks * ((nodes ? 64 * kNode : 0) + 8 + 32 + hash);
 }
 
@@ -348,8 +346,8 @@ double fields_memory(const Scene& scene, const ShellTotals& t, const MemoryCount
   const bool heights = grid_shells == 1 && scene.sources.empty();
   for (double pb : t.shell_pblocks) {
     const double gb = 2.2 * pb;
-    fields_bytes += grid_bytes(0, pb, gb, false, true, false) +
-                    gb * 64 * (16 * R + kVec3 + (heights ? 3 * R : 0));
+    fields_bytes +=
+        grid_bytes(0, pb, gb, true, false) + gb * 64 * (16 * R + kVec3 + (heights ? 3 * R : 0));
   }
   fields_bytes += 24 * n.shell_points + n.particle_blocks * 216 * 4 * R +
                   n.grid_blocks * (64 * kVec3 + 64 * 4 * R + 4 * grid_shells + 1);
@@ -373,9 +371,9 @@ SolverMemory estimate_solver_memory(const Scene& scene) {
 
   // The particles at the peak, and the combined grid.
   const double particles = per_particle * n.peak_particles();
-  const double grid = grid_bytes(
-      n.peak_particles() + t.grid_points, n.particle_blocks, n.grid_blocks, t.grid_shells > 0,
-      t.grid_shells > 0 || scene.shot.integrator == Integrator::Implicit);
+  const double grid =
+      grid_bytes(n.peak_particles() + t.grid_points, n.particle_blocks, n.grid_blocks,
+                 t.grid_shells > 0 || scene.shot.integrator == Integrator::Implicit);
   // The integrity monitor records a side per particle and limit vertex once shells are on
   // the grid.
   double integrity_bytes = t.integrity_bytes;

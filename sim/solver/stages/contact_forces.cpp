@@ -14,12 +14,13 @@ void ContactForcesStage::run(StepContext& c) {
     if (!c.contacts[i]) continue;
     GridShell& g = c.grid_shells[k++];
     prescribe_pins(*g.shell, c.time, c.dt, g.held);
-    g.contact->update_positions(g.shell->x.data(), c.opt.serial);
     if (c.scene.shot.integrator == Integrator::Implicit) {
       // The forces are part of the implicit grid solve: P2G transfers momentum only.
+      g.contact->update_positions(g.shell->x.data(), c.opt.serial);
       g.force.assign(g.shell->size(), Vec3::Zero());
       continue;
     }
+    // (forces also updates the site positions.)
     g.force.swap(c.shell_forces[i]);
     g.contact->forces(g.shell->x.data(), g.force.data(), c.opt.serial);
   }

@@ -3,6 +3,8 @@
 // energy with respect to grid node positions over one step (supplement sec. 2), and it
 // conserves momentum.
 #include <catch2/catch.hpp>
+
+#include <array>
 #include <map>
 #include <random>
 
@@ -69,14 +71,13 @@ struct Rig {
     GridShell& g = shells[0];
     g.force.assign(shell->size(), Vec3::Zero());
     contact->forces(shell->x.data(), g.force.data(), true);
-    grid.ensure_buffers();
     for (std::size_t b = 0; b < grid.num_particle_blocks(); ++b) {
-      auto& buf = grid.pblock_buf[b];
-      std::fill(buf.begin(), buf.end(), GridNode{0, {0, 0, 0}});
+      std::array<GridNode, kPadNodes> pad;
+      std::fill(pad.begin(), pad.end(), GridNode{0, {0, 0, 0}});
       shell_p2g_block(grid, table, shells, Real(1), b,
-                      buf.data());  // dt = 1, v = 0: momentum = force
+                      pad.data());  // dt = 1, v = 0: momentum = force
+      grid.add_pad_to_grid(b, pad.data());
     }
-    grid.gather_buffers_to_grid(true);
     std::map<std::uint64_t, Vec3d> tangential;
     for (std::size_t b = 0; b < grid.num_grid_blocks(); ++b)
       grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {

@@ -1,6 +1,8 @@
 // The grid update (sim/solver/stages/grid_update.cpp): node momentum to velocity, plus
 // gravity, for every node with mass, however small that mass is.
 #include <catch2/catch.hpp>
+
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -71,12 +73,11 @@ TEST_CASE("the grid update gives a node of subnormal mass a finite velocity",
   const Vec3 v0(Real(0.3), Real(-0.2), Real(0.1));
   c.grid.bin(std::vector<Vec3>{x}, true);
   REQUIRE(c.grid.num_particle_blocks() == 1);
-  c.grid.ensure_buffers();
-  auto& buf = c.grid.pblock_buf[0];
-  for (GridNode& nd : buf) nd = GridNode{0, {0, 0, 0}};
+  std::array<GridNode, kPadNodes> pad;
+  for (GridNode& nd : pad) nd = GridNode{0, {0, 0, 0}};
   const Vec3i bc = unpack_block(c.grid.pblock_key[0]) * kBlockSize;
-  apic_scatter<false>(buf.data(), W, bc, m, m * v0, Mat3::Zero(), Mat3::Zero());
-  c.grid.gather_buffers_to_grid(true);
+  apic_scatter<false>(pad.data(), W, bc, m, m * v0, Mat3::Zero(), Mat3::Zero());
+  c.grid.add_pad_to_grid(0, pad.data());
   int subnormal = 0;
   for (std::size_t b = 0; b < c.grid.num_grid_blocks(); ++b)
     c.grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i&) {
