@@ -193,17 +193,6 @@ class ShellFields {
         d.hmax = std::max(d.hmax, h);
       }
     }
-    /// Only the mass and height range of that share (heights_only_), the same bits as
-    /// add's.
-    [[gnu::always_inline]] void add_heights(Heights& d, Real w, const Row& r, int k) const {
-      const Real side = r.side + n[2] * (Real(k) - fx[2]);
-      d.m += w * L0[0];
-      if (w > 0) {
-        const Real h = align * side;  // fold_height
-        d.hmin = std::min(d.hmin, h);
-        d.hmax = std::max(d.hmax, h);
-      }
-    }
     /// The same at stencil offset (i, j, k).
     void add(Node& d, Real w, int i, int j, int k) const {
       Row r;
@@ -211,10 +200,35 @@ class ShellFields {
       add(d, w, r, k);
     }
   };
+  /// A control point's share of mass and height range only (heights_only_): the same bits
+  /// as PointShare's lanes 0, 14 and 15, without its other lanes.
+  struct HeightShare {
+    Real m, align;
+    Vec3 fx, n;
+    struct Row {
+      Real side;
+    };
+    HeightShare(const GridShell& gs, const Vec3& nj, const Vec3& f, std::uint32_t j, Real, Real,
+                bool)
+        : m(gs.shell->mass[j]), align(nj.dot(kAlign) >= 0 ? Real(1) : Real(-1)), fx(f), n(nj) {}
+    [[gnu::always_inline]] void row(int i, int j, Row& r) const {
+      r.side = n[0] * (Real(i) - fx[0]) + n[1] * (Real(j) - fx[1]);
+    }
+    [[gnu::always_inline]] void add(Heights& d, Real w, const Row& r, int k) const {
+      const Real side = r.side + n[2] * (Real(k) - fx[2]);
+      d.m += w * m;
+      if (w > 0) {
+        const Real h = align * side;  // fold_height
+        d.hmin = std::min(d.hmin, h);
+        d.hmax = std::max(d.hmax, h);
+      }
+    }
+  };
   void shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial);
   /// Walks F's control points colour by colour (blocks of a colour touch disjoint nodes)
-  /// and calls add(P, row, grid block, node, w, k) for each of their 27 stencil nodes.
-  template <class AddFn>
+  /// and calls add(P, row, grid block, node, w, k) for each of their 27 stencil nodes, P
+  /// the point's Share (PointShare or HeightShare).
+  template <class Share, class AddFn>
   void scatter_shares(Field& F, const GridShell& gs, Real dt, bool heights, bool serial, AddFn add);
   /// shell_p2g's sums of mass and heights only, into F.heights (heights_only_).
   void shell_p2g_heights(Field& F, const GridShell& gs, Real dt, bool serial);
