@@ -155,9 +155,8 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
         const auto [lo, hi] = slice(grid, b, nc, ns);
         if (lo == hi) return;
         GridNode pad[kPadNodes], inc[kPadNodes];
-        std::memset(static_cast<void*>(pad), 0, sizeof pad);
         std::memset(static_cast<void*>(inc), 0, sizeof inc);
-        grid.copy_grid_to_pad(b, pad);
+        grid.copy_grid_to_pad(b, pad);  // every node of the pad
         bool added = false;
         const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
         for (std::uint32_t s = lo; s < hi; ++s) {
@@ -170,18 +169,22 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
           const SiteMoments sm =
               site_moments(W, dx, bc, [&](const StencilNode& n) { return pad[n.pad()].m; });
           if (!sm.any) continue;
-          Real ga[27];
-          sm.dot(c.a3e[p], ga);
+          // dt f_n / m_n = -dt V (g_n . a3E) / m_n G3 with g_n / m_n = w_n Minv (d_n - dbar):
+          // w_n t_n (0, S) per node, t_n = (d_n - dbar) . Minv^T a3E, S = -dt V G3.
+          Real t[27];
+          sm.offsets_dot(c.a3e[p], t);
           const Real s0 = -dt * c.volume[p];
+          typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
+          const R4 S = {Real(0), s0 * G3[0], s0 * G3[1], s0 * G3[2]};
           int n = 0;
           for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
             const int k = n++;
             const int id = nd.pad();
             if (!(pad[id].m > 0)) return;
-            const Vec3 dv = (s0 * ga[k] / pad[id].m) * G3;
-            inc[id].v[0] += dv[0];
-            inc[id].v[1] += dv[1];
-            inc[id].v[2] += dv[2];
+            R4 acc;
+            std::memcpy(&acc, &inc[id], sizeof acc);
+            acc += (nd.w * t[k]) * S;
+            std::memcpy(&inc[id], &acc, sizeof acc);
           });
           added = true;
         }

@@ -88,17 +88,22 @@ struct SiteMoments {
   Real e[3][3];
   Mat3 Minv;
   bool any = false;  ///< false: no stencil node has mass (e and Minv unset)
-  /// g_n . u for all 27 nodes: a[n] (d_n - dbar) . (Minv^T u).
-  void dot(const Vec3& u, Real out[27]) const {
+  /// (d_n - dbar) . (Minv^T u) for all 27 nodes (g_n . u without the factor a[n]).
+  void offsets_dot(const Vec3& u, Real out[27]) const {
     const Vec3 q = Minv.transpose() * u;
     int n = 0;
     for (int i = 0; i < 3; ++i) {
       const Real si = e[0][i] * q[0];
       for (int j = 0; j < 3; ++j) {
         const Real sij = si + e[1][j] * q[1];
-        for (int k = 0; k < 3; ++k, ++n) out[n] = a[n] * (sij + e[2][k] * q[2]);
+        for (int k = 0; k < 3; ++k, ++n) out[n] = sij + e[2][k] * q[2];
       }
     }
+  }
+  /// g_n . u for all 27 nodes: a[n] (d_n - dbar) . (Minv^T u).
+  void dot(const Vec3& u, Real out[27]) const {
+    offsets_dot(u, out);
+    for (int n = 0; n < 27; ++n) out[n] = a[n] * out[n];
   }
 };
 /// The moments of the point with weights W on a grid of spacing dx [m]. The stencil is
