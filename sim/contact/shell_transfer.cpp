@@ -74,7 +74,44 @@ std::pair<std::uint32_t, std::uint32_t> slice(const SparseGrid& grid, std::size_
   return {static_cast<std::uint32_t>(lo), static_cast<std::uint32_t>(hi)};
 }
 
+/// Up to kSiteLanes contact sites of a particle block whose moments are taken together:
+/// their table slots, weights and node masses from the block's pad.
+struct SiteBatch {
+  int n = 0;
+  std::uint32_t slot[kSiteLanes];
+  QuadraticWeights W[kSiteLanes];
+  Real m[kSiteLanes][27];
+  SiteMoments sm[kSiteLanes];
+  /// Adds site `slot` at grid coordinates g; true when the batch is full.
+  bool add(std::uint32_t s, const Vec3& g, const Vec3i& bc, const GridNode* pad) {
+    slot[n] = s;
+    W[n] = QuadraticWeights(g);
+    int k = 0;
+    for_each_stencil_node(W[n], bc, [&](const StencilNode& nd) { m[n][k++] = pad[nd.pad()].m; });
+    return ++n == kSiteLanes;
+  }
+  void moments(Real dx) { site_moments_batch(W, m, n, dx, sm); }
+};
+
 }  // namespace
+
+void site_moments_batch(const QuadraticWeights* W, const Real (*m)[27], int n, Real dx,
+                        SiteMoments* out) {
+  typedef Real F __attribute__((vector_size(kSiteLanes * sizeof(Real))));
+  F w[3][3], fx[3], mm[27];
+  // Lanes past n repeat site 0 (results unused).
+  for (int j = 0; j < kSiteLanes; ++j) {
+    const int i = j < n ? j : 0;
+    for (int a = 0; a < 3; ++a) {
+      fx[a][j] = W[i].fx[a];
+      for (int o = 0; o < 3; ++o) w[a][o][j] = W[i].w[a][o];
+    }
+    for (int k = 0; k < 27; ++k) mm[k][j] = m[i][k];
+  }
+  MomentLanes<F> L;
+  moment_lanes<F>(w, fx, mm, dx, L);
+  for (int j = 0; j < n; ++j) moments_of_lane(L, j, W[j], out[j]);
+}
 
 void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
                      const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf) {
@@ -104,26 +141,32 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
   const std::vector<std::uint32_t>& order = grid.order();
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
-  for (std::uint32_t s = lo; s < hi; ++s) {
+  // The block's control points come first in its slice (the order ascends within a block).
+  std::uint32_t s = lo;
+  for (; s < hi && order[s] < nc; ++s) {
     const std::uint32_t g = order[s];
     GridShell& gs = shells[table.shell(g)];
     const std::uint32_t j = table.local(g);
-    if (g < nc) {
-      ShellObject& sh = *gs.shell;
-      const QuadraticWeights W(grid.grid_coord(sh.x[j]));
-      const ApicGather G = apic_gather<false>(buf, W, bc);
-      const Vec3& v = G.v;
-      gs.contact->C[j] = (Real(4) / dx) * G.B;  // B D^-1 with B in grid units times dx
-      const std::uint8_t held = gs.held[j];
-      for (int a = 0; a < 3; ++a)
-        if (!(held & (1u << a))) sh.v[j][a] = v[a];
-      sh.x[j] += dt * sh.v[j];
-    } else {
-      ShellContact& c = *gs.contact;
-      const QuadraticWeights W(grid.grid_coord(c.x[j]));
-      const SiteMoments sm =
-          site_moments(W, dx, bc, [&](const StencilNode& n) { return buf[n.pad()].m; });
+    ShellObject& sh = *gs.shell;
+    const QuadraticWeights W(grid.grid_coord(sh.x[j]));
+    const ApicGather G = apic_gather<false>(buf, W, bc);
+    const Vec3& v = G.v;
+    gs.contact->C[j] = (Real(4) / dx) * G.B;  // B D^-1 with B in grid units times dx
+    const std::uint8_t held = gs.held[j];
+    for (int a = 0; a < 3; ++a)
+      if (!(held & (1u << a))) sh.v[j][a] = v[a];
+    sh.x[j] += dt * sh.v[j];
+  }
+  // Contact particles, their moments kSiteLanes at a time.
+  SiteBatch batch;
+  auto flush = [&]() {
+    batch.moments(dx);
+    for (int i = 0; i < batch.n; ++i) {
+      const SiteMoments& sm = batch.sm[i];
       if (!sm.any) continue;
+      const std::uint32_t g = order[batch.slot[i]];
+      ShellContact& c = *shells[table.shell(g)].contact;
+      const std::uint32_t j = table.local(g);
       // grad~v a3E = sum_n v_n (g_n . a3E); nodes without mass have g_n = 0.
       Real ga[27];
       sm.dot(c.a3e[j], ga);
@@ -131,14 +174,21 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
       typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
       R4 sum = {};
       int n = 0;
-      for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
+      for_each_stencil_node(batch.W[i], bc, [&](const StencilNode& nd) {
         R4 node;
         std::memcpy(&node, &buf[nd.pad()], sizeof node);
         sum += ga[n++] * node;
       });
       c.a3e[j] += dt * Vec3(sum[1], sum[2], sum[3]);
     }
+    batch.n = 0;
+  };
+  for (; s < hi; ++s) {
+    const std::uint32_t g = order[s];
+    const ShellContact& c = *shells[table.shell(g)].contact;
+    if (batch.add(s, grid.grid_coord(c.x[table.local(g)]), bc, buf)) flush();
   }
+  if (batch.n) flush();
 }
 
 void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
@@ -159,35 +209,46 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
         grid.copy_grid_to_pad(b, pad);  // every node of the pad
         bool added = false;
         const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
+        SiteBatch batch;
+        auto flush = [&]() {
+          batch.moments(dx);
+          for (int i = 0; i < batch.n; ++i) {
+            const SiteMoments& sm = batch.sm[i];
+            if (!sm.any) continue;
+            const std::uint32_t g = order[batch.slot[i]];
+            const ShellContact& c = *shells[table.shell(g)].contact;
+            const std::uint32_t p = table.local(g);
+            // dt f_n / m_n = -dt V (g_n . a3E) / m_n G3 with g_n / m_n = w_n Minv (d_n -
+            // dbar): w_n t_n (0, S) per node, t_n = (d_n - dbar) . Minv^T a3E,
+            // S = -dt V G3.
+            Real t[27];
+            sm.offsets_dot(c.a3e[p], t);
+            const Real s0 = -dt * c.volume[p];
+            const Vec3& G3 = c.G3[p];
+            typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
+            const R4 S = {Real(0), s0 * G3[0], s0 * G3[1], s0 * G3[2]};
+            int n = 0;
+            for_each_stencil_node(batch.W[i], bc, [&](const StencilNode& nd) {
+              const int k = n++;
+              const int id = nd.pad();
+              if (!(pad[id].m > 0)) return;
+              R4 acc;
+              std::memcpy(&acc, &inc[id], sizeof acc);
+              acc += (nd.w * t[k]) * S;
+              std::memcpy(&inc[id], &acc, sizeof acc);
+            });
+            added = true;
+          }
+          batch.n = 0;
+        };
         for (std::uint32_t s = lo; s < hi; ++s) {
           const std::uint32_t g = order[s];
           const ShellContact& c = *shells[table.shell(g)].contact;
           const std::uint32_t p = table.local(g);
-          const Vec3& G3 = c.G3[p];
-          if (G3.squaredNorm() == 0) continue;
-          const QuadraticWeights W(grid.grid_coord(c.x[p]));
-          const SiteMoments sm =
-              site_moments(W, dx, bc, [&](const StencilNode& n) { return pad[n.pad()].m; });
-          if (!sm.any) continue;
-          // dt f_n / m_n = -dt V (g_n . a3E) / m_n G3 with g_n / m_n = w_n Minv (d_n - dbar):
-          // w_n t_n (0, S) per node, t_n = (d_n - dbar) . Minv^T a3E, S = -dt V G3.
-          Real t[27];
-          sm.offsets_dot(c.a3e[p], t);
-          const Real s0 = -dt * c.volume[p];
-          typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
-          const R4 S = {Real(0), s0 * G3[0], s0 * G3[1], s0 * G3[2]};
-          int n = 0;
-          for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
-            const int k = n++;
-            const int id = nd.pad();
-            if (!(pad[id].m > 0)) return;
-            R4 acc;
-            std::memcpy(&acc, &inc[id], sizeof acc);
-            acc += (nd.w * t[k]) * S;
-            std::memcpy(&inc[id], &acc, sizeof acc);
-          });
-          added = true;
+          if (c.G3[p].squaredNorm() == 0) continue;  // separated without shear: no force
+          if (batch.add(s, grid.grid_coord(c.x[p]), bc, pad)) flush();
         }
+        if (batch.n) flush();
         if (added) grid.add_pad_to_grid(b, inc);
       },
       serial);

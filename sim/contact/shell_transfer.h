@@ -84,7 +84,7 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
 /// 27 outer products up to round-off.
 struct SiteMoments {
   int base[3];
-  Real a[28];  ///< a[27]: scratch (the rows are written four scalars at a time)
+  Real a[27];
   Real e[3][3];
   Mat3 Minv;
   bool any = false;  ///< false: no stencil node has mass (e and Minv unset)
@@ -106,73 +106,121 @@ struct SiteMoments {
     for (int n = 0; n < 27; ++n) out[n] = a[n] * out[n];
   }
 };
-/// The moments of the point with weights W on a grid of spacing dx [m]. The stencil is
-/// walked with for_each_stencil_node(W, block_corner, ...) (sim/mpm/apic_stencil.h);
-/// mass(const StencilNode&) gives the mass of a node (>= 0). The sums run on the stencil's
-/// nine rows along z as short vectors: a row's a = (wx wy) (wz m), its marginals added
-/// row by row.
-template <class MassFn>
-SiteMoments site_moments(const QuadraticWeights& W, Real dx, const Vec3i& block_corner,
-                         MassFn mass) {
-  typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
-  SiteMoments sm;
-  for (int a = 0; a < 3; ++a) sm.base[a] = W.base[a];
-  Real m[28];
-  m[27] = 0;
-  int n = 0;
-  for_each_stencil_node(W, block_corner, [&](const StencilNode& nd) { m[n++] = mass(nd); });
-  const R4 wz = {W.w[2][0], W.w[2][1], W.w[2][2], Real(0)};
-  // Two-axis marginals of a: Aij = sum_k a, Aik = sum_j a, Ajk = sum_i a (rows over k).
-  Real Aij[3][3];
-  R4 Aik[3] = {}, Ajk[3] = {};
+/// The arithmetic of site_moments on one site per lane: F is Real (one site) or a GCC
+/// vector of Reals (several sites, each lane the same operations in the same order, so
+/// the same bits as one site alone). Inputs per lane: the weights w[axis][o], fx and the
+/// 27 node masses; outputs a, e, the inverse moment (symmetric: minv = 00 01 02 11 12 22)
+/// and asum (> 0 where any node has mass; elsewhere e and minv are not finite).
+template <class F>
+struct MomentLanes {
+  F a[27];
+  F e[3][3];
+  F minv[6];
+  F asum;
+};
+template <class F>
+[[gnu::always_inline]] inline void moment_lanes(const F (&w)[3][3], const F (&fx)[3],
+                                                const F (&m)[27], Real dx, MomentLanes<F>& out) {
+  // Two-axis marginals of a: Aij = sum_k a, Aik = sum_j a, Ajk = sum_i a.
+  F Aij[3][3], Aik[3][3], Ajk[3][3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
-      R4 mr;
-      std::memcpy(&mr, &m[9 * i + 3 * j], sizeof mr);
-      mr[3] = 0;
-      const R4 ar = (W.w[0][i] * W.w[1][j]) * (wz * mr);
-      std::memcpy(&sm.a[9 * i + 3 * j], &ar, sizeof ar);
-      Aij[i][j] = (ar[0] + ar[1]) + ar[2];
-      Aik[i] += ar;
-      Ajk[j] += ar;
+      const F wxy = w[0][i] * w[1][j];
+      F r[3];
+      for (int k = 0; k < 3; ++k) {
+        r[k] = wxy * (w[2][k] * m[9 * i + 3 * j + k]);
+        out.a[9 * i + 3 * j + k] = r[k];
+        Aik[i][k] = j == 0 ? r[k] : Aik[i][k] + r[k];
+        Ajk[j][k] = i == 0 ? r[k] : Ajk[j][k] + r[k];
+      }
+      Aij[i][j] = (r[0] + r[1]) + r[2];
     }
-  Real A[3][3];  // one-axis marginals A[axis][o]
-  const R4 Az = (Aik[0] + Aik[1]) + Aik[2];
+  F A[3][3];  // one-axis marginals A[axis][o]
   for (int o = 0; o < 3; ++o) {
-    A[0][o] = Aij[o][0] + Aij[o][1] + Aij[o][2];
-    A[1][o] = Aij[0][o] + Aij[1][o] + Aij[2][o];
-    A[2][o] = Az[o];
+    A[0][o] = (Aij[o][0] + Aij[o][1]) + Aij[o][2];
+    A[1][o] = (Aij[0][o] + Aij[1][o]) + Aij[2][o];
+    A[2][o] = (Aik[0][o] + Aik[1][o]) + Aik[2][o];
   }
-  const Real asum = A[0][0] + A[0][1] + A[0][2];
-  sm.any = asum > 0;
-  if (!sm.any) return sm;
+  const F asum = (A[0][0] + A[0][1]) + A[0][2];
+  out.asum = asum;
+  F(&e)[3][3] = out.e;
   for (int ax = 0; ax < 3; ++ax) {
-    Real d[3];
-    for (int o = 0; o < 3; ++o) d[o] = dx * (Real(o) - W.fx[ax]);
-    const Real dbar = (A[ax][0] * d[0] + A[ax][1] * d[1] + A[ax][2] * d[2]) / asum;
-    for (int o = 0; o < 3; ++o) sm.e[ax][o] = d[o] - dbar;
+    F d[3];
+    for (int o = 0; o < 3; ++o) d[o] = dx * (Real(o) - fx[ax]);
+    const F dbar = ((A[ax][0] * d[0] + A[ax][1] * d[1]) + A[ax][2] * d[2]) / asum;
+    for (int o = 0; o < 3; ++o) e[ax][o] = d[o] - dbar;
   }
   // Regularised by 1e-3 of the full-stencil moment (asum dx^2 / 4) in case the nodes with
   // mass are (nearly) coplanar.
-  const Real reg = Real(2.5e-4) * asum * dx * dx;
-  Mat3 M;
+  const F reg = (Real(2.5e-4) * dx * dx) * asum;
+  F M[3];
   for (int ax = 0; ax < 3; ++ax)
-    M(ax, ax) = reg + A[ax][0] * sm.e[ax][0] * sm.e[ax][0] + A[ax][1] * sm.e[ax][1] * sm.e[ax][1] +
-                A[ax][2] * sm.e[ax][2] * sm.e[ax][2];
-  const R4 ez = {sm.e[2][0], sm.e[2][1], sm.e[2][2], Real(0)};
-  Real mxy = 0, mxz = 0, myz = 0;
+    M[ax] = ((reg + (A[ax][0] * e[ax][0]) * e[ax][0]) + (A[ax][1] * e[ax][1]) * e[ax][1]) +
+            (A[ax][2] * e[ax][2]) * e[ax][2];
+  F mxy = F{} + Real(0), mxz = mxy, myz = mxy;
   for (int p = 0; p < 3; ++p) {
-    for (int r = 0; r < 3; ++r) mxy += Aij[p][r] * sm.e[0][p] * sm.e[1][r];
-    const R4 xz = Aik[p] * ez, yz = Ajk[p] * ez;
-    mxz += sm.e[0][p] * ((xz[0] + xz[1]) + xz[2]);
-    myz += sm.e[1][p] * ((yz[0] + yz[1]) + yz[2]);
+    mxy = mxy + e[0][p] * ((Aij[p][0] * e[1][0] + Aij[p][1] * e[1][1]) + Aij[p][2] * e[1][2]);
+    mxz = mxz + e[0][p] * ((Aik[p][0] * e[2][0] + Aik[p][1] * e[2][1]) + Aik[p][2] * e[2][2]);
+    myz = myz + e[1][p] * ((Ajk[p][0] * e[2][0] + Ajk[p][1] * e[2][1]) + Ajk[p][2] * e[2][2]);
   }
-  M(0, 1) = M(1, 0) = mxy;
-  M(0, 2) = M(2, 0) = mxz;
-  M(1, 2) = M(2, 1) = myz;
-  sm.Minv = M.inverse();
+  // The inverse of [[M0 mxy mxz] [mxy M1 myz] [mxz myz M2]] by cofactors.
+  const F c00 = M[1] * M[2] - myz * myz, c01 = mxz * myz - mxy * M[2], c02 = mxy * myz - M[1] * mxz;
+  const F inv_det = Real(1) / ((M[0] * c00 + mxy * c01) + mxz * c02);
+  out.minv[0] = c00 * inv_det;
+  out.minv[1] = c01 * inv_det;
+  out.minv[2] = c02 * inv_det;
+  out.minv[3] = (M[0] * M[2] - mxz * mxz) * inv_det;
+  out.minv[4] = (mxy * mxz - M[0] * myz) * inv_det;
+  out.minv[5] = (M[0] * M[1] - mxy * mxy) * inv_det;
+}
+
+/// Lane j of a MomentLanes as a SiteMoments (base from W).
+template <class F>
+inline void moments_of_lane(const MomentLanes<F>& L, int j, const QuadraticWeights& W,
+                            SiteMoments& sm) {
+  const auto lane = [j](const F& v) -> Real {
+    if constexpr (sizeof(F) == sizeof(Real))
+      return v;
+    else
+      return v[j];
+  };
+  for (int a = 0; a < 3; ++a) sm.base[a] = W.base[a];
+  for (int n = 0; n < 27; ++n) sm.a[n] = lane(L.a[n]);
+  sm.any = lane(L.asum) > 0;
+  if (!sm.any) return;
+  for (int a = 0; a < 3; ++a)
+    for (int o = 0; o < 3; ++o) sm.e[a][o] = lane(L.e[a][o]);
+  const Real m00 = lane(L.minv[0]), m01 = lane(L.minv[1]), m02 = lane(L.minv[2]),
+             m11 = lane(L.minv[3]), m12 = lane(L.minv[4]), m22 = lane(L.minv[5]);
+  sm.Minv << m00, m01, m02, m01, m11, m12, m02, m12, m22;
+}
+
+/// The moments of the point with weights W on a grid of spacing dx [m]. The stencil is
+/// walked with for_each_stencil_node(W, block_corner, ...) (sim/mpm/apic_stencil.h);
+/// mass(const StencilNode&) gives the mass of a node (>= 0). The sums are moment_lanes'
+/// (site_moments_batch: the same bits for several sites at once).
+template <class MassFn>
+SiteMoments site_moments(const QuadraticWeights& W, Real dx, const Vec3i& block_corner,
+                         MassFn mass) {
+  Real m[27], w[3][3], fx[3];
+  int n = 0;
+  for_each_stencil_node(W, block_corner, [&](const StencilNode& nd) { m[n++] = mass(nd); });
+  for (int a = 0; a < 3; ++a) {
+    fx[a] = W.fx[a];
+    for (int o = 0; o < 3; ++o) w[a][o] = W.w[a][o];
+  }
+  MomentLanes<Real> L;
+  moment_lanes<Real>(w, fx, m, dx, L);
+  SiteMoments sm;
+  moments_of_lane(L, 0, W, sm);
   return sm;
 }
+
+/// site_moments for n <= kSiteLanes sites at once (one per lane), each with its weights
+/// W[i] and node masses m[i] (stencil order): out[i], the same bits as site_moments.
+constexpr int kSiteLanes = 8;
+void site_moments_batch(const QuadraticWeights* W, const Real (*m)[27], int n, Real dx,
+                        SiteMoments* out);
 
 /// The 27 stencil nodes of a point with the mass-weighted gradient weights g_i described
 /// above (world units, 1/m); `massive[k]` false for nodes without mass (g = 0 there).

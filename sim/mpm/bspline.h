@@ -15,6 +15,7 @@ struct QuadraticWeights {
   Real w[3][3];   ///< w[axis][k], k = node offset 0..2
   Real dw[3][3];  ///< dw/dg
 
+  QuadraticWeights() = default;  ///< unset (a slot to fill)
   /// g: particle position in grid units (position relative to the grid origin / dx).
   explicit QuadraticWeights(const Vec3& g) {
     for (int a = 0; a < 3; ++a) {
