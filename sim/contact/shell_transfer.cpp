@@ -93,6 +93,32 @@ struct SiteBatch {
   void moments(Real dx) { site_moments_batch(W, m, n, dx, sm); }
 };
 
+/// Calls f(g, W, moments) for the contact sites in slots [lo, hi) of particle block b
+/// (corner bc, node masses in pad), in slot order, their moments taken kSiteLanes at a
+/// time; g is the site's point in the table. Sites where skip(g) and sites without a node
+/// with mass are left out.
+template <class Skip, class F>
+void for_each_site_moments(const SparseGrid& grid, const ShellPointTable& table,
+                           const std::vector<GridShell>& shells, std::uint32_t lo, std::uint32_t hi,
+                           const Vec3i& bc, const GridNode* pad, Skip skip, F f) {
+  const std::vector<std::uint32_t>& order = grid.order();
+  const Real dx = static_cast<Real>(grid.dx());
+  SiteBatch batch;
+  auto flush = [&]() {
+    batch.moments(dx);
+    for (int i = 0; i < batch.n; ++i)
+      if (batch.sm[i].any) f(order[batch.slot[i]], batch.W[i], batch.sm[i]);
+    batch.n = 0;
+  };
+  for (std::uint32_t s = lo; s < hi; ++s) {
+    const std::uint32_t g = order[s];
+    if (skip(g)) continue;
+    const ShellContact& c = *shells[table.shell(g)].contact;
+    if (batch.add(s, grid.grid_coord(c.x[table.local(g)]), bc, pad)) flush();
+  }
+  if (batch.n) flush();
+}
+
 }  // namespace
 
 void site_moments_batch(const QuadraticWeights* W, const Real (*m)[27], int n, Real dx,
@@ -158,48 +184,34 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
     sh.x[j] += dt * sh.v[j];
   }
   // Contact particles, their moments kSiteLanes at a time.
-  SiteBatch batch;
-  auto flush = [&]() {
-    batch.moments(dx);
-    for (int i = 0; i < batch.n; ++i) {
-      const SiteMoments& sm = batch.sm[i];
-      if (!sm.any) continue;
-      const std::uint32_t g = order[batch.slot[i]];
-      ShellContact& c = *shells[table.shell(g)].contact;
-      const std::uint32_t j = table.local(g);
-      // grad~v a3E = sum_n v_n (g_n . a3E); nodes without mass have g_n = 0.
-      Real ga[27];
-      sm.dot(c.a3e[j], ga);
-      // sum_n ga[n] (m, v) over the nodes as 4-vectors: the velocity part is lanes 1..3.
-      typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
-      R4 sum = {};
-      int n = 0;
-      for_each_stencil_node(batch.W[i], bc, [&](const StencilNode& nd) {
-        R4 node;
-        std::memcpy(&node, &buf[nd.pad()], sizeof node);
-        sum += ga[n++] * node;
+  for_each_site_moments(
+      grid, table, shells, s, hi, bc, buf, [](std::uint32_t) { return false; },
+      [&](std::uint32_t g, const QuadraticWeights& W, const SiteMoments& sm) {
+        ShellContact& c = *shells[table.shell(g)].contact;
+        const std::uint32_t j = table.local(g);
+        // grad~v a3E = sum_n v_n (g_n . a3E); nodes without mass have g_n = 0.
+        Real ga[27];
+        sm.dot(c.a3e[j], ga);
+        // sum_n ga[n] (m, v) over the nodes as 4-vectors: the velocity part is lanes 1..3.
+        typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
+        R4 sum = {};
+        int n = 0;
+        for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
+          R4 node;
+          std::memcpy(&node, &buf[nd.pad()], sizeof node);
+          sum += ga[n++] * node;
+        });
+        c.a3e[j] += dt * Vec3(sum[1], sum[2], sum[3]);
       });
-      c.a3e[j] += dt * Vec3(sum[1], sum[2], sum[3]);
-    }
-    batch.n = 0;
-  };
-  for (; s < hi; ++s) {
-    const std::uint32_t g = order[s];
-    const ShellContact& c = *shells[table.shell(g)].contact;
-    if (batch.add(s, grid.grid_coord(c.x[table.local(g)]), bc, buf)) flush();
-  }
-  if (batch.n) flush();
 }
 
 void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
                            const std::vector<GridShell>& shells, Real dt, bool serial) {
   const std::uint32_t nc = table.num_control_points();
   const auto ns = static_cast<std::uint32_t>(table.size());
-  const std::vector<std::uint32_t>& order = grid.order();
   // Colour by colour (blocks of a colour touch disjoint nodes): each block with contact
   // particles reads its nodes' masses and adds its velocity increments straight into the
-  // grid. (Nearly every site has G3 != 0: the shear term alone makes it nonzero.)
-  const Real dx = static_cast<Real>(grid.dx());
+  // grid.
   grid.for_each_block_by_colour(
       [&](std::size_t b) {
         const auto [lo, hi] = slice(grid, b, nc, ns);
@@ -209,46 +221,35 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
         grid.copy_grid_to_pad(b, pad);  // every node of the pad
         bool added = false;
         const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
-        SiteBatch batch;
-        auto flush = [&]() {
-          batch.moments(dx);
-          for (int i = 0; i < batch.n; ++i) {
-            const SiteMoments& sm = batch.sm[i];
-            if (!sm.any) continue;
-            const std::uint32_t g = order[batch.slot[i]];
-            const ShellContact& c = *shells[table.shell(g)].contact;
-            const std::uint32_t p = table.local(g);
-            // dt f_n / m_n = -dt V (g_n . a3E) / m_n G3 with g_n / m_n = w_n Minv (d_n -
-            // dbar): w_n t_n (0, S) per node, t_n = (d_n - dbar) . Minv^T a3E,
-            // S = -dt V G3.
-            Real t[27];
-            sm.offsets_dot(c.a3e[p], t);
-            const Real s0 = -dt * c.volume[p];
-            const Vec3& G3 = c.G3[p];
-            typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
-            const R4 S = {Real(0), s0 * G3[0], s0 * G3[1], s0 * G3[2]};
-            int n = 0;
-            for_each_stencil_node(batch.W[i], bc, [&](const StencilNode& nd) {
-              const int k = n++;
-              const int id = nd.pad();
-              if (!(pad[id].m > 0)) return;
-              R4 acc;
-              std::memcpy(&acc, &inc[id], sizeof acc);
-              acc += (nd.w * t[k]) * S;
-              std::memcpy(&inc[id], &acc, sizeof acc);
+        for_each_site_moments(
+            grid, table, shells, lo, hi, bc, pad,
+            [&](std::uint32_t g) {  // separated without shear: no force
+              return shells[table.shell(g)].contact->G3[table.local(g)].squaredNorm() == 0;
+            },
+            [&](std::uint32_t g, const QuadraticWeights& W, const SiteMoments& sm) {
+              const ShellContact& c = *shells[table.shell(g)].contact;
+              const std::uint32_t p = table.local(g);
+              // dt f_n / m_n = -dt V (g_n . a3E) / m_n G3 with g_n / m_n = w_n Minv (d_n -
+              // dbar): w_n t_n (0, S) per node, t_n = (d_n - dbar) . Minv^T a3E,
+              // S = -dt V G3.
+              Real t[27];
+              sm.offsets_dot(c.a3e[p], t);
+              const Real s0 = -dt * c.volume[p];
+              const Vec3& G3 = c.G3[p];
+              typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
+              const R4 S = {Real(0), s0 * G3[0], s0 * G3[1], s0 * G3[2]};
+              int n = 0;
+              for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
+                const int k = n++;
+                const int id = nd.pad();
+                if (!(pad[id].m > 0)) return;
+                R4 acc;
+                std::memcpy(&acc, &inc[id], sizeof acc);
+                acc += (nd.w * t[k]) * S;
+                std::memcpy(&inc[id], &acc, sizeof acc);
+              });
+              added = true;
             });
-            added = true;
-          }
-          batch.n = 0;
-        };
-        for (std::uint32_t s = lo; s < hi; ++s) {
-          const std::uint32_t g = order[s];
-          const ShellContact& c = *shells[table.shell(g)].contact;
-          const std::uint32_t p = table.local(g);
-          if (c.G3[p].squaredNorm() == 0) continue;  // separated without shear: no force
-          if (batch.add(s, grid.grid_coord(c.x[p]), bc, pad)) flush();
-        }
-        if (batch.n) flush();
         if (added) grid.add_pad_to_grid(b, inc);
       },
       serial);

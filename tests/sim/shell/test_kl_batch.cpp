@@ -42,6 +42,26 @@ ShellMaterialDesc metal() {
   return m;
 }
 
+/// Every layer's F^P moved off identity by up to 0.05 (rng), then positions from rest:
+/// stretched 1.9x along x past x = 0.5 (past the default stretch limit 1.5), bent and
+/// perturbed everywhere, and shifted by `offset`.
+std::vector<Eigen::Vector3f> plastic_and_bent(KirchhoffLoveShellT<float>& shf,
+                                              const std::vector<Eigen::Vector3d>& rest,
+                                              std::mt19937& rng, const Eigen::Vector3f& offset) {
+  std::uniform_real_distribution<float> u(-1, 1);
+  std::vector<float> pf = shf.plastic_state();
+  for (float& v : pf) v += 0.05f * u(rng);
+  shf.set_plastic_state(pf);
+  std::vector<Eigen::Vector3f> x(rest.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    Eigen::Vector3d p = rest[i];
+    if (p.x() > 0.5) p.x() = 0.5 + 1.9 * (p.x() - 0.5);
+    p.z() += 0.1 * p.x() * p.x() + 0.01 * u(rng);
+    x[i] = p.cast<float>() + offset;
+  }
+  return x;
+}
+
 }  // namespace
 
 TEST_CASE("the lane logarithm is within 2 ulp of std::log, with its special values", "[kl]") {
@@ -134,17 +154,8 @@ TEST_CASE("the float KL kernel gives the same bits on every instruction set", "[
       });
   KirchhoffLoveShellT<float> shf(s.points, s.weights, rest, metal(), 3);
   std::mt19937 rng(4);
-  std::uniform_real_distribution<float> u(-1, 1);
-  std::vector<float> pf = shf.plastic_state();
-  for (float& v : pf) v += 0.05f * u(rng);
-  shf.set_plastic_state(pf);
-  std::vector<Eigen::Vector3f> x(rest.size());
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    Eigen::Vector3d p = rest[i];
-    if (p.x() > 0.5) p.x() = 0.5 + 1.9 * (p.x() - 0.5);
-    p.z() += 0.1 * p.x() * p.x() + 0.01 * u(rng);
-    x[i] = p.cast<float>() + Eigen::Vector3f(100.0f, -50.0f, 20.0f);  // far from the origin
-  }
+  const std::vector<Eigen::Vector3f> x =
+      plastic_and_bent(shf, rest, rng, Eigen::Vector3f(100.0f, -50.0f, 20.0f));  // far out
   struct Restore {
     SimdLevel saved = simd_level();
     ~Restore() { set_simd_level(saved); }
@@ -196,17 +207,7 @@ TEST_CASE(
   KirchhoffLoveShellT<float> shf(s.points, s.weights, rest, mat, 3);
   REQUIRE(shf.patched());
   std::mt19937 rng(6);
-  std::uniform_real_distribution<float> u(-1, 1);
-  std::vector<float> pf = shf.plastic_state();
-  for (float& v : pf) v += 0.05f * u(rng);
-  shf.set_plastic_state(pf);
-  std::vector<Eigen::Vector3f> x(rest.size());
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    Eigen::Vector3d p = rest[i];
-    if (p.x() > 0.5) p.x() = 0.5 + 1.9 * (p.x() - 0.5);
-    p.z() += 0.1 * p.x() * p.x() + 0.01 * u(rng);
-    x[i] = p.cast<float>();
-  }
+  const std::vector<Eigen::Vector3f> x = plastic_and_bent(shf, rest, rng, Eigen::Vector3f::Zero());
   std::vector<Eigen::Vector3f> fp(x.size(), Eigen::Vector3f::Zero()), fq = fp;
   const auto ep = shf.energy(x.data(), fp.data(), false, true);
   shf.use_patches(false);
