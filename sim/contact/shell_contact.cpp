@@ -159,55 +159,93 @@ double ShellContact::energy(const Vec3* ctrl, bool serial) const {
   });
 }
 
-ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
-  struct Acc {
-    std::size_t compressed = 0, sliding = 0;
-    double friction = 0, separation = 0;
-    Acc& operator+=(const Acc& o) {
-      compressed += o.compressed;
-      sliding += o.sliding;
-      friction += o.friction;
-      separation += o.separation;
-      return *this;
-    }
+void ShellContact::FrameLanes::run() {
+  // (Helpers write through references: a GCC vector this wide is not returned by value.)
+  const auto dot = [](const D* u, const D* v, D& out) {
+    out = (u[0] * v[0] + u[1] * v[1]) + u[2] * v[2];
   };
-  const Acc a = ordered_reduce(num_sites(), kGrain, serial, Acc{}, [&](std::size_t p) {
-    Vec3 a1, a2;
-    tangents(ctrl, p, a1, a2);
-    // The frame in double: in float |q3| = 1 - O(1e-7) with a bias, and rebuilding a3E from
-    // it every step would shrink a sticking column steadily (a spurious compression).
-    const ContactFrameT<double> fr =
-        contact_frame<double>(a1.cast<double>(), a2.cast<double>(), a3e[p].cast<double>());
-    Vec3 s = fr.s.cast<Real>();
-    // Round-off separation: a column within kSeparationTolerance of its rest length is
-    // treated as separated (stored energy below k_c 1e-18 / 3).
-    if (s[2] > Real(1) - kSeparationTolerance) s[2] = std::max(s[2], Real(1));
-    const Real psi0 = contact_energy_density<Real>(s, params_);
-    const Real slip0 = std::hypot(s[0], s[1]);
-    const ContactState st = contact_return_map<Real>(s, params_);
-    a3e[p] = (static_cast<double>(s[0]) * fr.q[0] + static_cast<double>(s[1]) * fr.q[1] +
-              static_cast<double>(s[2]) * fr.q[2])
-                 .cast<Real>();
-    state[p] = static_cast<std::uint8_t>(st);
-    Acc r;
-    const double V = static_cast<double>(volume[p]);
-    if (st == ContactState::Separated) {
-      r.separation = V * static_cast<double>(psi0 - contact_energy_density<Real>(s, params_));
-    } else {
-      // Counted as in contact when the compression is above round-off.
-      r.compressed = s[2] < Real(1) - kCompressionTolerance ? 1 : 0;
-      if (st == ContactState::Sliding) {
-        // Plastic work: shear stress on the cone times the slip (the return mapping's
-        // analogue of sigma_y * delta eps_p; the trial energy's excess over it is a
-        // discretization term of order dt).
-        const Real slip1 = std::hypot(s[0], s[1]);
-        r.sliding = 1;
-        r.friction = V * static_cast<double>(params_.gamma) * static_cast<double>(slip1) *
-                     static_cast<double>(slip0 - slip1);
-      }
+  const auto root = [](D& x) {
+    for (int j = 0; j < kFrameLanes; ++j) x[j] = std::sqrt(x[j]);
+  };
+  D r11, r12, r22;
+  dot(a1, a1, r11);
+  root(r11);
+  for (int c = 0; c < 3; ++c) q[0][c] = a1[c] / r11;
+  dot(q[0], a2, r12);
+  D u[3];
+  for (int c = 0; c < 3; ++c) u[c] = a2[c] - r12 * q[0][c];
+  dot(u, u, r22);
+  root(r22);
+  for (int c = 0; c < 3; ++c) q[1][c] = u[c] / r22;
+  q[2][0] = q[0][1] * q[1][2] - q[0][2] * q[1][1];
+  q[2][1] = q[0][2] * q[1][0] - q[0][0] * q[1][2];
+  q[2][2] = q[0][0] * q[1][1] - q[0][1] * q[1][0];
+  for (int i = 0; i < 3; ++i) dot(q[i], a3e, s[i]);
+}
+
+ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const FrameLanes& fl,
+                                                          int j) {
+  // The frame in double: in float |q3| = 1 - O(1e-7) with a bias, and rebuilding a3E from
+  // it every step would shrink a sticking column steadily (a spurious compression).
+  Vec3d q[3];
+  for (int i = 0; i < 3; ++i) q[i] = Vec3d(fl.q[i][0][j], fl.q[i][1][j], fl.q[i][2][j]);
+  Vec3 s(static_cast<Real>(fl.s[0][j]), static_cast<Real>(fl.s[1][j]),
+         static_cast<Real>(fl.s[2][j]));
+  // Round-off separation: a column within kSeparationTolerance of its rest length is
+  // treated as separated (stored energy below k_c 1e-18 / 3).
+  if (s[2] > Real(1) - kSeparationTolerance) s[2] = std::max(s[2], Real(1));
+  const Real psi0 = contact_energy_density<Real>(s, params_);
+  const Real slip0 = std::hypot(s[0], s[1]);
+  const ContactState st = contact_return_map<Real>(s, params_);
+  a3e[p] = (static_cast<double>(s[0]) * q[0] + static_cast<double>(s[1]) * q[1] +
+            static_cast<double>(s[2]) * q[2])
+               .cast<Real>();
+  state[p] = static_cast<std::uint8_t>(st);
+  ReturnMapSums r;
+  const double V = static_cast<double>(volume[p]);
+  if (st == ContactState::Separated) {
+    r.separation = V * static_cast<double>(psi0 - contact_energy_density<Real>(s, params_));
+  } else {
+    // Counted as in contact when the compression is above round-off.
+    r.compressed = s[2] < Real(1) - kCompressionTolerance ? 1 : 0;
+    if (st == ContactState::Sliding) {
+      // Plastic work: shear stress on the cone times the slip (the return mapping's
+      // analogue of sigma_y * delta eps_p; the trial energy's excess over it is a
+      // discretization term of order dt).
+      const Real slip1 = std::hypot(s[0], s[1]);
+      r.sliding = 1;
+      r.friction = V * static_cast<double>(params_.gamma) * static_cast<double>(slip1) *
+                   static_cast<double>(slip0 - slip1);
     }
-    return r;
-  });
+  }
+  return r;
+}
+
+ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
+  using Acc = ReturnMapSums;
+  // The frames of kFrameLanes sites at a time (frame_lanes: their square roots and
+  // divisions overlap), then each site's return mapping in site order.
+  const Acc a =
+      ordered_reduce_chunks(num_sites(), kGrain, serial, Acc{}, [&](std::size_t b, std::size_t e) {
+        Acc acc;
+        for (std::size_t p0 = b; p0 < e; p0 += kFrameLanes) {
+          const int n = static_cast<int>(std::min<std::size_t>(kFrameLanes, e - p0));
+          FrameLanes fl;
+          for (int j = 0; j < kFrameLanes; ++j) {
+            const std::size_t p = p0 + std::size_t(j < n ? j : 0);
+            Vec3 a1, a2;
+            tangents(ctrl, p, a1, a2);
+            for (int c = 0; c < 3; ++c) {
+              fl.a1[c][j] = static_cast<double>(a1[c]);
+              fl.a2[c][j] = static_cast<double>(a2[c]);
+              fl.a3e[c][j] = static_cast<double>(a3e[p][c]);
+            }
+          }
+          fl.run();
+          for (int j = 0; j < n; ++j) acc += return_map_site(p0 + std::size_t(j), fl, j);
+        }
+        return acc;
+      });
   ContactStepStats out;
   out.compressed = a.compressed;
   out.sliding = a.sliding;

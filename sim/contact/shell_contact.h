@@ -65,6 +65,31 @@ class ShellContact {
   std::vector<Real> N, N1, N2;
 
  private:
+  /// The friction return mapping's sums over sites.
+  struct ReturnMapSums {
+    std::size_t compressed = 0, sliding = 0;
+    double friction = 0, separation = 0;
+    ReturnMapSums& operator+=(const ReturnMapSums& o) {
+      compressed += o.compressed;
+      sliding += o.sliding;
+      friction += o.friction;
+      separation += o.separation;
+      return *this;
+    }
+  };
+  /// contact_frame in double for kFrameLanes sites, one per lane of a GCC vector (each
+  /// lane the operations of contact_frame<double>): inputs a1, a2, a3e and outputs the
+  /// frame q and s, each [component][lane] (q[i][component][lane]).
+  static constexpr int kFrameLanes = 8;
+  struct FrameLanes {
+    typedef double D __attribute__((vector_size(kFrameLanes * sizeof(double))));
+    D a1[3], a2[3], a3e[3];
+    D q[3][3], s[3];
+    void run();
+  };
+  /// The return mapping of site p with its frame in lane j of fl.
+  ReturnMapSums return_map_site(std::size_t p, const FrameLanes& fl, int j);
+
   ContactParams params_;
   // Transposed stencils for the force gather: for control point j, entries
   // [toff[j], toff[j+1]) name a site and its dN/dxi.
