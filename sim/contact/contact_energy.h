@@ -32,19 +32,42 @@ struct ContactFrameT {
   V3 s;             ///< third column of R: Q^T a3E
 };
 
+/// The Gram-Schmidt QR of [a1, a2, a3E] by components: T is a scalar or a GCC vector of
+/// lanes (each lane the same operations: ShellContact's frames of several sites at once);
+/// root(x) takes the square root of x in place.
+template <class T, class Root>
+inline void contact_frame_parts(const T (&a1)[3], const T (&a2)[3], const T (&a3e)[3], Root root,
+                                T (&q)[3][3], T& r11, T& r12, T& r22, T (&s)[3]) {
+  const auto dot = [](const T(&u)[3], const T(&v)[3], T& out) {
+    out = (u[0] * v[0] + u[1] * v[1]) + u[2] * v[2];
+  };
+  dot(a1, a1, r11);
+  root(r11);
+  for (int c = 0; c < 3; ++c) q[0][c] = a1[c] / r11;
+  dot(q[0], a2, r12);
+  T u[3];
+  for (int c = 0; c < 3; ++c) u[c] = a2[c] - r12 * q[0][c];
+  dot(u, u, r22);
+  root(r22);
+  for (int c = 0; c < 3; ++c) q[1][c] = u[c] / r22;
+  q[2][0] = q[0][1] * q[1][2] - q[0][2] * q[1][1];
+  q[2][1] = q[0][2] * q[1][0] - q[0][0] * q[1][2];
+  q[2][2] = q[0][0] * q[1][1] - q[0][1] * q[1][0];
+  for (int i = 0; i < 3; ++i) dot(q[i], a3e, s[i]);
+}
+
 /// Gram-Schmidt QR of [a1, a2, a3E] (a1, a2 must be independent).
 template <class T>
 ContactFrameT<T> contact_frame(const Eigen::Matrix<T, 3, 1>& a1, const Eigen::Matrix<T, 3, 1>& a2,
                                const Eigen::Matrix<T, 3, 1>& a3e) {
+  const T b1[3] = {a1[0], a1[1], a1[2]}, b2[3] = {a2[0], a2[1], a2[2]},
+          b3[3] = {a3e[0], a3e[1], a3e[2]};
+  T q[3][3], s[3];
   ContactFrameT<T> f;
-  f.r11 = a1.norm();
-  f.q[0] = a1 / f.r11;
-  f.r12 = f.q[0].dot(a2);
-  const Eigen::Matrix<T, 3, 1> u = a2 - f.r12 * f.q[0];
-  f.r22 = u.norm();
-  f.q[1] = u / f.r22;
-  f.q[2] = f.q[0].cross(f.q[1]);
-  f.s = Eigen::Matrix<T, 3, 1>(f.q[0].dot(a3e), f.q[1].dot(a3e), f.q[2].dot(a3e));
+  contact_frame_parts(
+      b1, b2, b3, [](T& x) { x = std::sqrt(x); }, q, f.r11, f.r12, f.r22, s);
+  for (int i = 0; i < 3; ++i) f.q[i] = Eigen::Matrix<T, 3, 1>(q[i][0], q[i][1], q[i][2]);
+  f.s = Eigen::Matrix<T, 3, 1>(s[0], s[1], s[2]);
   return f;
 }
 

@@ -160,27 +160,13 @@ double ShellContact::energy(const Vec3* ctrl, bool serial) const {
 }
 
 void ShellContact::FrameLanes::run() {
-  // (Helpers write through references: a GCC vector this wide is not returned by value.)
-  const auto dot = [](const D* u, const D* v, D& out) {
-    out = (u[0] * v[0] + u[1] * v[1]) + u[2] * v[2];
-  };
-  const auto root = [](D& x) {
-    for (int j = 0; j < kFrameLanes; ++j) x[j] = std::sqrt(x[j]);
-  };
   D r11, r12, r22;
-  dot(a1, a1, r11);
-  root(r11);
-  for (int c = 0; c < 3; ++c) q[0][c] = a1[c] / r11;
-  dot(q[0], a2, r12);
-  D u[3];
-  for (int c = 0; c < 3; ++c) u[c] = a2[c] - r12 * q[0][c];
-  dot(u, u, r22);
-  root(r22);
-  for (int c = 0; c < 3; ++c) q[1][c] = u[c] / r22;
-  q[2][0] = q[0][1] * q[1][2] - q[0][2] * q[1][1];
-  q[2][1] = q[0][2] * q[1][0] - q[0][0] * q[1][2];
-  q[2][2] = q[0][0] * q[1][1] - q[0][1] * q[1][0];
-  for (int i = 0; i < 3; ++i) dot(q[i], a3e, s[i]);
+  contact_frame_parts(
+      a1, a2, a3e,
+      [](D& x) {
+        for (int j = 0; j < kFrameLanes; ++j) x[j] = std::sqrt(x[j]);
+      },
+      q, r11, r12, r22, s);
 }
 
 ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const FrameLanes& fl,
@@ -223,7 +209,7 @@ ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const F
 
 ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
   using Acc = ReturnMapSums;
-  // The frames of kFrameLanes sites at a time (frame_lanes: their square roots and
+  // The frames of kFrameLanes sites at a time (FrameLanes: their square roots and
   // divisions overlap), then each site's return mapping in site order.
   const Acc a =
       ordered_reduce_chunks(num_sites(), kGrain, serial, Acc{}, [&](std::size_t b, std::size_t e) {

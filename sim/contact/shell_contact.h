@@ -77,9 +77,9 @@ class ShellContact {
       return *this;
     }
   };
-  /// contact_frame in double for kFrameLanes sites, one per lane of a GCC vector (each
-  /// lane the operations of contact_frame<double>): inputs a1, a2, a3e and outputs the
-  /// frame q and s, each [component][lane] (q[i][component][lane]).
+  /// contact_frame in double for kFrameLanes sites, one per lane of a GCC vector
+  /// (contact_frame_parts): inputs a1, a2, a3e and outputs the frame q and s, each
+  /// [component][lane] (q[i][component][lane]).
   static constexpr int kFrameLanes = 8;
   struct FrameLanes {
     typedef double D __attribute__((vector_size(kFrameLanes * sizeof(double))));
