@@ -91,6 +91,32 @@ Eigen::Matrix<T, 3, 1> contact_dpsi_ds(const Eigen::Matrix<T, 3, 1>& s, const Co
   return Eigen::Matrix<T, 3, 1>(g * s[0], g * s[1], -kc * c * c);
 }
 
+/// contact_gradient's arithmetic from the frame (q, r11, r12, r22, s of
+/// contact_frame_parts) on scalars or lanes: T is E or a GCC vector of E (each lane the
+/// same operations, so the same bits as one site alone). Outputs psi and the columns
+/// g[col][component] of G (see contact_gradient).
+template <class E, class T>
+inline void contact_gradient_parts(const T (&q)[3][3], const T& r11, const T& r12, const T& r22,
+                                   const T (&s)[3], const ContactParams& p, T& psi, T (&g)[3][3]) {
+  const E gamma = static_cast<E>(p.gamma), kc = static_cast<E>(p.kc);
+  const auto compressed = s[2] < E(1);  // a lane mask for vectors
+  const T zero{};
+  // As contact_energy_density and contact_dpsi_ds, in their order of operations.
+  const T c = compressed ? E(1) - s[2] : zero;
+  const T shear = gamma / E(2) * (s[0] * s[0] + s[1] * s[1]);
+  psi = compressed ? shear + kc / E(3) * c * c * c : shear;
+  const T d[3] = {gamma * s[0], gamma * s[1], -kc * c * c};
+  const T k = gamma * s[2] - d[2];
+  const T l1 = s[0] * k, l2 = s[1] * k;
+  const T m2 = l2 / r22;
+  const T m1 = (l1 - r12 * m2) / r11;
+  for (int i = 0; i < 3; ++i) {
+    g[0][i] = m1 * q[2][i];
+    g[1][i] = m2 * q[2][i];
+    g[2][i] = (d[0] * q[0][i] + d[1] * q[1][i]) + d[2] * q[2][i];
+  }
+}
+
 /// Gradient of psi with respect to the columns of D: G.col(0) = dpsi/da1,
 /// G.col(1) = dpsi/da2, G.col(2) = dpsi/da3E. Equal to tau D^-T (tau the Kirchhoff
 /// stress), written without D^-1: G.col(2) = Q dpsi/ds and G.col(beta) = m_beta q3 with
@@ -101,18 +127,14 @@ template <class T>
 T contact_gradient(const Eigen::Matrix<T, 3, 1>& a1, const Eigen::Matrix<T, 3, 1>& a2,
                    const Eigen::Matrix<T, 3, 1>& a3e, const ContactParams& p,
                    Eigen::Matrix<T, 3, 3>* G) {
-  const ContactFrameT<T> f = contact_frame(a1, a2, a3e);
-  const T psi = contact_energy_density(f.s, p);
-  if (G) {
-    const Eigen::Matrix<T, 3, 1> d = contact_dpsi_ds(f.s, p);
-    const T k = static_cast<T>(p.gamma) * f.s[2] - d[2];
-    const T l1 = f.s[0] * k, l2 = f.s[1] * k;
-    const T m2 = l2 / f.r22;
-    const T m1 = (l1 - f.r12 * m2) / f.r11;
-    G->col(0) = m1 * f.q[2];
-    G->col(1) = m2 * f.q[2];
-    G->col(2) = d[0] * f.q[0] + d[1] * f.q[1] + d[2] * f.q[2];
-  }
+  const T b1[3] = {a1[0], a1[1], a1[2]}, b2[3] = {a2[0], a2[1], a2[2]},
+          b3[3] = {a3e[0], a3e[1], a3e[2]};
+  T q[3][3], s[3], r11, r12, r22, psi, g[3][3];
+  contact_frame_parts(
+      b1, b2, b3, [](T& x) { x = std::sqrt(x); }, q, r11, r12, r22, s);
+  contact_gradient_parts<T>(q, r11, r12, r22, s, p, psi, g);
+  if (G)
+    for (int c = 0; c < 3; ++c) G->col(c) = Eigen::Matrix<T, 3, 1>(g[c][0], g[c][1], g[c][2]);
   return psi;
 }
 

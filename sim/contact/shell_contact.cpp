@@ -117,25 +117,53 @@ void ShellContact::reset(const Vec3* ctrl, bool serial) {
 }
 
 double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
-  const double e = ordered_reduce(num_sites(), kGrain, serial, 0.0, [&](std::size_t p) {
-    // Position and tangents in one pass over the stencil (as update_positions, tangents).
-    const Vec3 ref = ctrl[idx[off[p]]];
-    Vec3 d = Vec3::Zero(), a1 = Vec3::Zero(), a2 = Vec3::Zero();
-    for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
-      const Vec3 dk = ctrl[idx[k]] - ref;
-      d += N[k] * dk;
-      a1 += N1[k] * dk;
-      a2 += N2[k] * dk;
-    }
-    x[p] = ref + d;
-    Mat3 G;
-    const Real psi = contact_gradient<Real>(a1, a2, a3e[p], params_, &G);
-    const Real V = volume[p];
-    G1_[p] = V * G.col(0);
-    G2_[p] = V * G.col(1);
-    G3[p] = G.col(2);
-    return static_cast<double>(V * psi);
-  });
+  // Position and tangents per site in one pass over its stencil (as update_positions and
+  // tangents), then the gradients of kFrameLanes sites at a time (their square roots and
+  // divisions overlap), the energy summed in site order.
+  const double e =
+      ordered_reduce_chunks(num_sites(), kGrain, serial, 0.0, [&](std::size_t b, std::size_t en) {
+        double acc = 0.0;
+        for (std::size_t p0 = b; p0 < en; p0 += kFrameLanes) {
+          const int n = static_cast<int>(std::min<std::size_t>(kFrameLanes, en - p0));
+          GradientLanes gl;
+          for (int j = 0; j < kFrameLanes; ++j) {
+            const int from = j < n ? j : 0;  // lanes past n repeat site p0
+            const std::size_t p = p0 + static_cast<std::size_t>(from);
+            if (j == from) {
+              const Vec3 ref = ctrl[idx[off[p]]];
+              Vec3 d = Vec3::Zero(), a1 = Vec3::Zero(), a2 = Vec3::Zero();
+              for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
+                const Vec3 dk = ctrl[idx[k]] - ref;
+                d += N[k] * dk;
+                a1 += N1[k] * dk;
+                a2 += N2[k] * dk;
+              }
+              x[p] = ref + d;
+              for (int c = 0; c < 3; ++c) {
+                gl.a1[c][j] = a1[c];
+                gl.a2[c][j] = a2[c];
+                gl.a3e[c][j] = a3e[p][c];
+              }
+            } else {
+              for (int c = 0; c < 3; ++c) {
+                gl.a1[c][j] = gl.a1[c][0];
+                gl.a2[c][j] = gl.a2[c][0];
+                gl.a3e[c][j] = gl.a3e[c][0];
+              }
+            }
+          }
+          gl.run(params_);
+          for (int j = 0; j < n; ++j) {
+            const std::size_t p = p0 + static_cast<std::size_t>(j);
+            const Real V = volume[p];
+            G1_[p] = V * Vec3(gl.g[0][0][j], gl.g[0][1][j], gl.g[0][2][j]);
+            G2_[p] = V * Vec3(gl.g[1][0][j], gl.g[1][1][j], gl.g[1][2][j]);
+            G3[p] = Vec3(gl.g[2][0][j], gl.g[2][1][j], gl.g[2][2][j]);
+            acc += static_cast<double>(V * gl.psi[j]);
+          }
+        }
+        return acc;
+      });
   parallel_for(
       num_control_points(), kGrain,
       [&](std::size_t b, std::size_t en) {
@@ -167,6 +195,17 @@ void ShellContact::FrameLanes::run() {
         for (int j = 0; j < kFrameLanes; ++j) x[j] = std::sqrt(x[j]);
       },
       q, r11, r12, r22, s);
+}
+
+void ShellContact::GradientLanes::run(const ContactParams& params) {
+  R q[3][3], r11, r12, r22, s[3];
+  contact_frame_parts(
+      a1, a2, a3e,
+      [](R& v) {
+        for (int j = 0; j < kFrameLanes; ++j) v[j] = std::sqrt(v[j]);
+      },
+      q, r11, r12, r22, s);
+  contact_gradient_parts<Real>(q, r11, r12, r22, s, params, psi, g);
 }
 
 ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const FrameLanes& fl,

@@ -87,6 +87,15 @@ class ShellContact {
     D q[3][3], s[3];
     void run();
   };
+  /// contact_gradient for kFrameLanes sites, one per lane (contact_frame_parts and
+  /// contact_gradient_parts, so each lane has the bits of the site alone): inputs a1, a2,
+  /// a3e, outputs psi and G (g[column][component][lane]).
+  struct GradientLanes {
+    typedef Real R __attribute__((vector_size(kFrameLanes * sizeof(Real))));
+    R a1[3], a2[3], a3e[3];
+    R psi, g[3][3];
+    void run(const ContactParams& params);
+  };
   /// The return mapping of site p with its frame in lane j of fl.
   ReturnMapSums return_map_site(std::size_t p, const FrameLanes& fl, int j);
 

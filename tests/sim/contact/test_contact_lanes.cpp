@@ -1,0 +1,97 @@
+// Contact gradients of several sites at once (contact_gradient_parts on GCC vector lanes,
+// ShellContact::forces eight sites at a time) against one site alone: the same bits.
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <random>
+
+#include "sim/contact/shell_contact.h"
+#include "sim/shell/procedural_mesh.h"
+
+using namespace shellmpm;
+
+namespace {
+
+ContactParams params() {
+  ContactParams p;
+  p.kc = 2.0e5;
+  p.gamma = 5.0e4;
+  p.friction = 0.4;
+  return p;
+}
+
+bool same_bits(Real a, Real b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+}  // namespace
+
+TEST_CASE("contact gradient on lanes gives each lane the bits of its site alone", "[contact]") {
+  constexpr int L = 8;
+  typedef Real R __attribute__((vector_size(L * sizeof(Real))));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  R a1[3], a2[3], a3[3];
+  Vec3 b1[L], b2[L], b3[L];
+  for (int j = 0; j < L; ++j) {
+    // Compressed, separated and exactly at rest length (s3 = 1) sites, with shear.
+    const Real s3 = j % 3 == 0 ? Real(0.7) + Real(0.2) * u(rng) : (j % 3 == 1 ? Real(1.1) : 1);
+    b1[j] = Vec3(Real(1.1) + Real(0.1) * u(rng), Real(0.1) * u(rng), Real(0.1) * u(rng));
+    b2[j] = Vec3(Real(0.2) * u(rng), Real(0.9), Real(0.1) * u(rng));
+    b3[j] = Vec3(Real(0.2) * u(rng), Real(0.2) * u(rng), s3);
+    for (int c = 0; c < 3; ++c) {
+      a1[c][j] = b1[j][c];
+      a2[c][j] = b2[j][c];
+      a3[c][j] = b3[j][c];
+    }
+  }
+  R q[3][3], r11, r12, r22, s[3], psi, g[3][3];
+  contact_frame_parts(
+      a1, a2, a3,
+      [](R& v) {
+        for (int j = 0; j < L; ++j) v[j] = std::sqrt(v[j]);
+      },
+      q, r11, r12, r22, s);
+  contact_gradient_parts<Real>(q, r11, r12, r22, s, params(), psi, g);
+  int compressed = 0;
+  for (int j = 0; j < L; ++j) {
+    Mat3 G;
+    const Real psi1 = contact_gradient<Real>(b1[j], b2[j], b3[j], params(), &G);
+    compressed += s[2][j] < 1;
+    CHECK(same_bits(psi[j], psi1));
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < 3; ++i) CHECK(same_bits(g[c][i][j], G(i, c)));
+  }
+  CHECK(compressed >= 2);  // both branches of f(s3) are exercised
+}
+
+TEST_CASE("ShellContact::forces gives every site the scalar gradient's bits, partial lanes too",
+          "[contact]") {
+  const ShellMesh sheet = make_sheet(1.0, 0.8, 7, 5);  // 70 sites: a partial last batch
+  const LoopBasis basis(static_cast<int>(sheet.vertices.size()), sheet.triangles);
+  ShellContact c(basis, sheet.vertices, 1e-3, 1, params());
+  REQUIRE(c.num_sites() % 8 != 0);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  std::vector<Vec3> x(sheet.vertices.size());
+  for (std::size_t i = 0; i < x.size(); ++i)
+    x[i] = sheet.vertices[i].cast<Real>() + Real(0.02) * Vec3(u(rng), u(rng), u(rng));
+  for (std::size_t p = 0; p < c.num_sites(); ++p)  // compressed (~half) and separated
+    c.a3e[p] = Vec3(Real(0.1) * u(rng), Real(0.9) + Real(0.2) * u(rng), Real(0.1) * u(rng));
+  std::vector<Vec3> f(x.size(), Vec3::Zero());
+  const double e = c.forces(x.data(), f.data(), true);
+  double e1 = 0;
+  int compressed = 0;
+  for (std::size_t p = 0; p < c.num_sites(); ++p) {
+    Vec3 a1, a2;
+    c.tangents(x.data(), p, a1, a2);
+    Mat3 G;
+    const Real psi = contact_gradient<Real>(a1, a2, c.a3e[p], params(), &G);
+    e1 += static_cast<double>(c.volume[p] * psi);
+    compressed += G.col(2).norm() > Real(1e3);  // k_c (1 - s3)^2 > 1e3 Pa
+    for (int i = 0; i < 3; ++i) CHECK(same_bits(c.G3[p][i], G(i, 2)));
+  }
+  CHECK(e == e1);
+  CHECK(compressed > 10);
+  CHECK(f[x.size() / 2].norm() > 0);
+}
