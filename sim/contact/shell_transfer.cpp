@@ -74,70 +74,56 @@ std::pair<std::uint32_t, std::uint32_t> slice(const SparseGrid& grid, std::size_
   return {static_cast<std::uint32_t>(lo), static_cast<std::uint32_t>(hi)};
 }
 
-/// Up to kSiteLanes contact sites of a particle block whose moments are taken together:
-/// their table slots, weights and node masses from the block's pad.
+/// Up to kSiteLanes contact sites of a particle block whose gradient dots are taken
+/// together: their table slots, weights, node masses (from the block's pad) and a3E.
 struct SiteBatch {
   int n = 0;
   std::uint32_t slot[kSiteLanes];
   QuadraticWeights W[kSiteLanes];
-  Real m[kSiteLanes][27];
-  SiteMoments sm[kSiteLanes];
-  /// Adds site `slot` at grid coordinates g; true when the batch is full.
-  bool add(std::uint32_t s, const Vec3& g, const Vec3i& bc, const GridNode* pad) {
+  SiteLaneInputs in;
+  alignas(32) Real dots[27][kSiteLanes];
+  bool any[kSiteLanes];
+  /// Adds site `slot` at grid coordinates g with normal column a3e; true when the batch
+  /// is full.
+  bool add(std::uint32_t s, const Vec3& g, const Vec3& a3e, const Vec3i& bc, const GridNode* pad) {
     slot[n] = s;
     W[n] = QuadraticWeights(g);
+    in.set(n, W[n], a3e);
     int k = 0;
-    for_each_stencil_node(W[n], bc, [&](const StencilNode& nd) { m[n][k++] = pad[nd.pad()].m; });
+    for_each_stencil_node(W[n], bc, [&](const StencilNode& nd) { in.m[k++][n] = pad[nd.pad()].m; });
     return ++n == kSiteLanes;
   }
-  void moments(Real dx) { site_moments_batch(W, m, n, dx, sm); }
 };
 
-/// Calls f(g, W, moments) for the contact sites in slots [lo, hi) of particle block b
-/// (corner bc, node masses in pad), in slot order, their moments taken kSiteLanes at a
-/// time; g is the site's point in the table. Sites where skip(g) and sites without a node
-/// with mass are left out.
+/// Calls f(g, W, dots, j) for the contact sites in slots [lo, hi) of particle block b
+/// (corner bc, node masses in pad), in slot order, their gradient dots with a3E taken
+/// kSiteLanes at a time (site_dots_batch; weighted: g_n . a3E, else without the factor
+/// a_n): dots[k][j] for stencil node k; g is the site's point in the table. Sites where
+/// skip(g) and sites without a node with mass are left out.
 template <class Skip, class F>
-void for_each_site_moments(const SparseGrid& grid, const ShellPointTable& table,
-                           const std::vector<GridShell>& shells, std::uint32_t lo, std::uint32_t hi,
-                           const Vec3i& bc, const GridNode* pad, Skip skip, F f) {
+void for_each_site_dots(const SparseGrid& grid, const ShellPointTable& table,
+                        const std::vector<GridShell>& shells, std::uint32_t lo, std::uint32_t hi,
+                        const Vec3i& bc, const GridNode* pad, bool weighted, Skip skip, F f) {
   const std::vector<std::uint32_t>& order = grid.order();
   const Real dx = static_cast<Real>(grid.dx());
   SiteBatch batch;
   auto flush = [&]() {
-    batch.moments(dx);
+    site_dots_batch(batch.in, batch.n, dx, weighted, batch.dots, batch.any);
     for (int i = 0; i < batch.n; ++i)
-      if (batch.sm[i].any) f(order[batch.slot[i]], batch.W[i], batch.sm[i]);
+      if (batch.any[i]) f(order[batch.slot[i]], batch.W[i], batch.dots, i);
     batch.n = 0;
   };
   for (std::uint32_t s = lo; s < hi; ++s) {
     const std::uint32_t g = order[s];
     if (skip(g)) continue;
     const ShellContact& c = *shells[table.shell(g)].contact;
-    if (batch.add(s, grid.grid_coord(c.x[table.local(g)]), bc, pad)) flush();
+    const std::uint32_t p = table.local(g);
+    if (batch.add(s, grid.grid_coord(c.x[p]), c.a3e[p], bc, pad)) flush();
   }
   if (batch.n) flush();
 }
 
 }  // namespace
-
-void site_moments_batch(const QuadraticWeights* W, const Real (*m)[27], int n, Real dx,
-                        SiteMoments* out) {
-  typedef Real F __attribute__((vector_size(kSiteLanes * sizeof(Real))));
-  F w[3][3], fx[3], mm[27];
-  // Lanes past n repeat site 0 (results unused).
-  for (int j = 0; j < kSiteLanes; ++j) {
-    const int i = j < n ? j : 0;
-    for (int a = 0; a < 3; ++a) {
-      fx[a][j] = W[i].fx[a];
-      for (int o = 0; o < 3; ++o) w[a][o][j] = W[i].w[a][o];
-    }
-    for (int k = 0; k < 27; ++k) mm[k][j] = m[i][k];
-  }
-  MomentLanes<F> L;
-  moment_lanes<F>(w, fx, mm, dx, L);
-  for (int j = 0; j < n; ++j) moments_of_lane(L, j, W[j], out[j]);
-}
 
 void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
                      const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf) {
@@ -183,23 +169,21 @@ void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
       if (!(held & (1u << a))) sh.v[j][a] = v[a];
     sh.x[j] += dt * sh.v[j];
   }
-  // Contact particles, their moments kSiteLanes at a time.
-  for_each_site_moments(
-      grid, table, shells, s, hi, bc, buf, [](std::uint32_t) { return false; },
-      [&](std::uint32_t g, const QuadraticWeights& W, const SiteMoments& sm) {
+  // Contact particles, their gradient dots kSiteLanes at a time.
+  for_each_site_dots(
+      grid, table, shells, s, hi, bc, buf, true, [](std::uint32_t) { return false; },
+      [&](std::uint32_t g, const QuadraticWeights& W, const Real(&ga)[27][kSiteLanes], int lane) {
         ShellContact& c = *shells[table.shell(g)].contact;
         const std::uint32_t j = table.local(g);
-        // grad~v a3E = sum_n v_n (g_n . a3E); nodes without mass have g_n = 0.
-        Real ga[27];
-        sm.dot(c.a3e[j], ga);
-        // sum_n ga[n] (m, v) over the nodes as 4-vectors: the velocity part is lanes 1..3.
+        // grad~v a3E = sum_n v_n (g_n . a3E); nodes without mass have g_n = 0. The sum of
+        // ga[n] (m, v) over the nodes as 4-vectors: the velocity part is lanes 1..3.
         typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
         R4 sum = {};
         int n = 0;
         for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
           R4 node;
           std::memcpy(&node, &buf[nd.pad()], sizeof node);
-          sum += ga[n++] * node;
+          sum += ga[n++][lane] * node;
         });
         c.a3e[j] += dt * Vec3(sum[1], sum[2], sum[3]);
       });
@@ -221,19 +205,18 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
         grid.copy_grid_to_pad(b, pad);  // every node of the pad
         bool added = false;
         const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
-        for_each_site_moments(
-            grid, table, shells, lo, hi, bc, pad,
+        for_each_site_dots(
+            grid, table, shells, lo, hi, bc, pad, false,
             [&](std::uint32_t g) {  // separated without shear: no force
               return shells[table.shell(g)].contact->G3[table.local(g)].squaredNorm() == 0;
             },
-            [&](std::uint32_t g, const QuadraticWeights& W, const SiteMoments& sm) {
+            [&](std::uint32_t g, const QuadraticWeights& W, const Real(&t)[27][kSiteLanes],
+                int lane) {
               const ShellContact& c = *shells[table.shell(g)].contact;
               const std::uint32_t p = table.local(g);
               // dt f_n / m_n = -dt V (g_n . a3E) / m_n G3 with g_n / m_n = w_n Minv (d_n -
               // dbar): w_n t_n (0, S) per node, t_n = (d_n - dbar) . Minv^T a3E,
               // S = -dt V G3.
-              Real t[27];
-              sm.offsets_dot(c.a3e[p], t);
               const Real s0 = -dt * c.volume[p];
               const Vec3& G3 = c.G3[p];
               typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
@@ -245,7 +228,7 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
                 if (!(pad[id].m > 0)) return;
                 R4 acc;
                 std::memcpy(&acc, &inc[id], sizeof acc);
-                acc += (nd.w * t[k]) * S;
+                acc += (nd.w * t[k][lane]) * S;
                 std::memcpy(&inc[id], &acc, sizeof acc);
               });
               added = true;

@@ -90,7 +90,8 @@ struct SiteMoments {
   bool any = false;  ///< false: no stencil node has mass (e and Minv unset)
   /// (d_n - dbar) . (Minv^T u) for all 27 nodes (g_n . u without the factor a[n]).
   void offsets_dot(const Vec3& u, Real out[27]) const {
-    const Vec3 q = Minv.transpose() * u;
+    Vec3 q;
+    for (int r = 0; r < 3; ++r) q[r] = (Minv(0, r) * u[0] + Minv(1, r) * u[1]) + Minv(2, r) * u[2];
     int n = 0;
     for (int i = 0; i < 3; ++i) {
       const Real si = e[0][i] * q[0];
@@ -198,7 +199,7 @@ inline void moments_of_lane(const MomentLanes<F>& L, int j, const QuadraticWeigh
 /// The moments of the point with weights W on a grid of spacing dx [m]. The stencil is
 /// walked with for_each_stencil_node(W, block_corner, ...) (sim/mpm/apic_stencil.h);
 /// mass(const StencilNode&) gives the mass of a node (>= 0). The sums are moment_lanes'
-/// (site_moments_batch: the same bits for several sites at once).
+/// (site_dots_batch: the same bits for several sites at once).
 template <class MassFn>
 SiteMoments site_moments(const QuadraticWeights& W, Real dx, const Vec3i& block_corner,
                          MassFn mass) {
@@ -216,11 +217,30 @@ SiteMoments site_moments(const QuadraticWeights& W, Real dx, const Vec3i& block_
   return sm;
 }
 
-/// site_moments for n <= kSiteLanes sites at once (one per lane), each with its weights
-/// W[i] and node masses m[i] (stencil order): out[i], the same bits as site_moments.
 constexpr int kSiteLanes = 8;
-void site_moments_batch(const QuadraticWeights* W, const Real (*m)[27], int n, Real dx,
-                        SiteMoments* out);
+/// The inputs of up to kSiteLanes sites in lane order ([...][lane], the layout of the
+/// batch's vectors): weights, fx, the 27 node masses in stencil order and a vector u.
+struct SiteLaneInputs {
+  alignas(32) Real w[3][3][kSiteLanes];
+  alignas(32) Real fx[3][kSiteLanes];
+  alignas(32) Real m[27][kSiteLanes];
+  alignas(32) Real u[3][kSiteLanes];
+  /// Lane j's weights and fx from W and its u (its masses go to m[k][j]).
+  void set(int j, const QuadraticWeights& W, const Vec3& uj) {
+    for (int a = 0; a < 3; ++a) {
+      fx[a][j] = W.fx[a];
+      u[a][j] = uj[a];
+      for (int o = 0; o < 3; ++o) w[a][o][j] = W.w[a][o];
+    }
+  }
+};
+/// For the first n <= kSiteLanes sites of `in` at once, one per lane: out[k][j] =
+/// site_moments(site j).offsets_dot(u_j)[k], or .dot(u_j)[k] when `weighted`, the same
+/// bits; any[j] = its moments' `any` (out unset where false). Lanes n.. of `in` are
+/// overwritten. Runs on the widest instruction set simd_level() allows
+/// (sim/contact/site_dots.h).
+void site_dots_batch(SiteLaneInputs& in, int n, Real dx, bool weighted, Real (&out)[27][kSiteLanes],
+                     bool (&any)[kSiteLanes]);
 
 /// The 27 stencil nodes of a point with the mass-weighted gradient weights g_i described
 /// above (world units, 1/m); `massive[k]` false for nodes without mass (g = 0 there).
