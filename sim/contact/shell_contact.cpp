@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
@@ -28,6 +29,8 @@ ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& res
   G3.assign(ns, Vec3::Zero());
   G1_.assign(ns, Vec3::Zero());
   G2_.assign(ns, Vec3::Zero());
+  a1_.assign(ns, Vec3::Zero());
+  a2_.assign(ns, Vec3::Zero());
   volume.resize(ns);
   state.assign(ns, static_cast<std::uint8_t>(ContactState::Separated));
   C.assign(rest.size(), Mat3::Zero());
@@ -86,6 +89,21 @@ void ShellContact::tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2)
   }
 }
 
+void ShellContact::position_and_tangents(const Vec3* ctrl, std::size_t p, Vec3& xp, Vec3& a1,
+                                         Vec3& a2) const {
+  const Vec3 ref = ctrl[idx[off[p]]];
+  Vec3 d = Vec3::Zero();
+  a1.setZero();
+  a2.setZero();
+  for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
+    const Vec3 dk = ctrl[idx[k]] - ref;
+    d += N[k] * dk;
+    a1 += N1[k] * dk;
+    a2 += N2[k] * dk;
+  }
+  xp = ref + d;
+}
+
 void ShellContact::update_positions(const Vec3* ctrl, bool serial) {
   parallel_for(
       num_sites(), kGrain,
@@ -117,9 +135,13 @@ void ShellContact::reset(const Vec3* ctrl, bool serial) {
 }
 
 double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
-  // Position and tangents per site in one pass over its stencil (as update_positions and
-  // tangents), then the gradients of kFrameLanes sites at a time (their square roots and
-  // divisions overlap), the energy summed in site order.
+  // Positions and tangents: those of the last return mapping where it saw these control
+  // points, else one pass over each stencil. Then the gradients of kFrameLanes sites at a
+  // time (their square roots and divisions overlap), the energy summed in site order.
+  const std::size_t nc = num_control_points();
+  const bool kept = tangents_ctrl_.size() == nc &&
+                    std::memcmp(static_cast<const void*>(tangents_ctrl_.data()),
+                                static_cast<const void*>(ctrl), nc * sizeof(Vec3)) == 0;
   const double e =
       ordered_reduce_chunks(num_sites(), kGrain, serial, 0.0, [&](std::size_t b, std::size_t en) {
         double acc = 0.0;
@@ -129,27 +151,20 @@ double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
           for (int j = 0; j < kFrameLanes; ++j) {
             const int from = j < n ? j : 0;  // lanes past n repeat site p0
             const std::size_t p = p0 + static_cast<std::size_t>(from);
-            if (j == from) {
-              const Vec3 ref = ctrl[idx[off[p]]];
-              Vec3 d = Vec3::Zero(), a1 = Vec3::Zero(), a2 = Vec3::Zero();
-              for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
-                const Vec3 dk = ctrl[idx[k]] - ref;
-                d += N[k] * dk;
-                a1 += N1[k] * dk;
-                a2 += N2[k] * dk;
-              }
-              x[p] = ref + d;
-              for (int c = 0; c < 3; ++c) {
-                gl.a1[c][j] = a1[c];
-                gl.a2[c][j] = a2[c];
-                gl.a3e[c][j] = a3e[p][c];
-              }
+            Vec3 a1, a2;
+            if (kept) {
+              a1 = a1_[p];
+              a2 = a2_[p];
+            } else if (j == from) {
+              position_and_tangents(ctrl, p, x[p], a1, a2);
             } else {
-              for (int c = 0; c < 3; ++c) {
-                gl.a1[c][j] = gl.a1[c][0];
-                gl.a2[c][j] = gl.a2[c][0];
-                gl.a3e[c][j] = gl.a3e[c][0];
-              }
+              a1 = Vec3(gl.a1[0][0], gl.a1[1][0], gl.a1[2][0]);
+              a2 = Vec3(gl.a2[0][0], gl.a2[1][0], gl.a2[2][0]);
+            }
+            for (int c = 0; c < 3; ++c) {
+              gl.a1[c][j] = a1[c];
+              gl.a2[c][j] = a2[c];
+              gl.a3e[c][j] = a3e[p][c];
             }
           }
           gl.run(params_);
@@ -259,7 +274,14 @@ ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
           for (int j = 0; j < kFrameLanes; ++j) {
             const std::size_t p = p0 + std::size_t(j < n ? j : 0);
             Vec3 a1, a2;
-            tangents(ctrl, p, a1, a2);
+            if (j < n) {  // kept for the next forces() call
+              position_and_tangents(ctrl, p, x[p], a1, a2);
+              a1_[p] = a1;
+              a2_[p] = a2;
+            } else {
+              a1 = a1_[p];
+              a2 = a2_[p];
+            }
             for (int c = 0; c < 3; ++c) {
               fl.a1[c][j] = static_cast<double>(a1[c]);
               fl.a2[c][j] = static_cast<double>(a2[c]);
@@ -271,6 +293,7 @@ ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
         }
         return acc;
       });
+  tangents_ctrl_.assign(ctrl, ctrl + num_control_points());
   ContactStepStats out;
   out.compressed = a.compressed;
   out.sliding = a.sliding;

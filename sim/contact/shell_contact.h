@@ -43,7 +43,8 @@ class ShellContact {
   double forces(const Vec3* ctrl, Vec3* f, bool serial);
   /// Energy only [J].
   double energy(const Vec3* ctrl, bool serial) const;
-  /// Coulomb return mapping with the current control points and a3E; rewrites a3E.
+  /// Coulomb return mapping with the current control points and a3E; rewrites a3E and
+  /// updates the site positions x.
   ContactStepStats return_map(const Vec3* ctrl, bool serial);
   /// Makes the current shape the contact rest state: a3E = the unit normal, C = 0, and
   /// the positions updated (after a pre-roll moved the control points).
@@ -99,7 +100,15 @@ class ShellContact {
   /// The return mapping of site p with its frame in lane j of fl.
   ReturnMapSums return_map_site(std::size_t p, const FrameLanes& fl, int j);
 
+  /// Site p's position and tangents in one pass over its stencil (the sums of
+  /// update_positions and tangents).
+  void position_and_tangents(const Vec3* ctrl, std::size_t p, Vec3& xp, Vec3& a1, Vec3& a2) const;
+
   ContactParams params_;
+  // The tangents of the last return mapping and the control points they came from: the
+  // next forces() call takes them (and the positions it wrote) instead of walking the
+  // stencils again when the control points are bit for bit the same.
+  std::vector<Vec3> a1_, a2_, tangents_ctrl_;
   // Transposed stencils for the force gather: for control point j, entries
   // [toff[j], toff[j+1]) name a site and its dN/dxi.
   std::vector<std::uint32_t> toff, tsite;

@@ -264,9 +264,12 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
   const double sites = T * m.contact_samples;
   n.contact_sites += sites;
   const double site_support = S;
+  // (Per site: x, a3E, G3, volume, state, stencil and transposed stencil, G1, G2 and the
+  // return mapping's tangents; per control point C, the transposed offsets and the
+  // tangents' control points.)
   t.contact_bytes += sites * (3 * kVec3 + R + 1 + 4 + site_support * (4 + 3 * R) +
-                              site_support * (4 + 2 * R) + 2 * kVec3) +
-                     V * (kMat3 + 4);
+                              site_support * (4 + 2 * R) + 4 * kVec3) +
+                     V * (kMat3 + 4 + kVec3);
   // The integrity monitor's own limit mesh (level 0), edges, rim distances, positions.
   t.integrity_bytes += limit_mesh_bytes(V, T, S, false) + V * (8 + 48 + 3) + 1.5 * T * 8;
   // The shell guard (sim/contact/shell_guard.h): its own limit mesh, edges (1.5 T), rest

@@ -65,8 +65,40 @@ TEST_CASE("contact gradient on lanes gives each lane the bits of its site alone"
   CHECK(compressed >= 2);  // both branches of f(s3) are exercised
 }
 
-TEST_CASE("ShellContact::forces gives every site the scalar gradient's bits, partial lanes too",
-          "[contact]") {
+namespace {
+
+/// Checks c.forces(x) against contact_gradient on each site alone, bit for bit (G3, the
+/// energy and the positions); returns the number of compressed sites.
+int check_forces(ShellContact& c, const std::vector<Vec3>& x) {
+  std::vector<Vec3> f(x.size(), Vec3::Zero());
+  const double e = c.forces(x.data(), f.data(), true);
+  ShellContact ref = c;
+  ref.update_positions(x.data(), true);
+  double e1 = 0;
+  int compressed = 0;
+  for (std::size_t p = 0; p < c.num_sites(); ++p) {
+    Vec3 a1, a2;
+    c.tangents(x.data(), p, a1, a2);
+    Mat3 G;
+    const Real psi = contact_gradient<Real>(a1, a2, c.a3e[p], params(), &G);
+    e1 += static_cast<double>(c.volume[p] * psi);
+    compressed += G.col(2).norm() > Real(1e3);  // k_c (1 - s3)^2 > 1e3 Pa
+    for (int i = 0; i < 3; ++i) {
+      CHECK(same_bits(c.G3[p][i], G(i, 2)));
+      CHECK(same_bits(c.x[p][i], ref.x[p][i]));
+    }
+  }
+  CHECK(e == e1);
+  CHECK(f[x.size() / 2].norm() > 0);
+  return compressed;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "ShellContact::forces gives every site the scalar gradient's bits, partial lanes and "
+    "tangents kept from the return mapping too",
+    "[contact]") {
   const ShellMesh sheet = make_sheet(1.0, 0.8, 7, 5);  // 70 sites: a partial last batch
   const LoopBasis basis(static_cast<int>(sheet.vertices.size()), sheet.triangles);
   ShellContact c(basis, sheet.vertices, 1e-3, 1, params());
@@ -78,20 +110,13 @@ TEST_CASE("ShellContact::forces gives every site the scalar gradient's bits, par
     x[i] = sheet.vertices[i].cast<Real>() + Real(0.02) * Vec3(u(rng), u(rng), u(rng));
   for (std::size_t p = 0; p < c.num_sites(); ++p)  // compressed (~half) and separated
     c.a3e[p] = Vec3(Real(0.1) * u(rng), Real(0.9) + Real(0.2) * u(rng), Real(0.1) * u(rng));
-  std::vector<Vec3> f(x.size(), Vec3::Zero());
-  const double e = c.forces(x.data(), f.data(), true);
-  double e1 = 0;
-  int compressed = 0;
-  for (std::size_t p = 0; p < c.num_sites(); ++p) {
-    Vec3 a1, a2;
-    c.tangents(x.data(), p, a1, a2);
-    Mat3 G;
-    const Real psi = contact_gradient<Real>(a1, a2, c.a3e[p], params(), &G);
-    e1 += static_cast<double>(c.volume[p] * psi);
-    compressed += G.col(2).norm() > Real(1e3);  // k_c (1 - s3)^2 > 1e3 Pa
-    for (int i = 0; i < 3; ++i) CHECK(same_bits(c.G3[p][i], G(i, 2)));
-  }
-  CHECK(e == e1);
-  CHECK(compressed > 10);
-  CHECK(f[x.size() / 2].norm() > 0);
+  CHECK(check_forces(c, x) > 10);
+  // The return mapping keeps its tangents for these control points: the next forces()
+  // takes them, with the same bits.
+  c.return_map(x.data(), true);
+  CHECK(check_forces(c, x) > 0);
+  // Control points that moved after the return mapping: walked again.
+  c.return_map(x.data(), true);
+  x[x.size() / 2].y() += Real(0.01);
+  CHECK(check_forces(c, x) > 0);
 }
