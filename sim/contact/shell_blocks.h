@@ -1,0 +1,232 @@
+// The per-block loops of the shells' transfers (sim/contact/shell_transfer.h) for one
+// particle block: the control points' APIC P2G and G2P, the contact sites' G2P (a3E
+// advected with the mass-weighted gradient) and their normal forces. The library compiles
+// them for x86-64-v2 (shell_transfer.cpp); shell_blocks_avx2.cpp and
+// shell_blocks_avx512.cpp compile the same functions for wider units (the stencil rows of
+// sim/mpm/stencil_row.h and the site dots of site_dots.h in one register), with no
+// contraction into fused multiply-adds, and shell_transfer.cpp picks one at run time
+// (simd_level()). Every instruction set gives the same bits
+// (tests/sim/contact/test_contact_solver.cpp, "bit-identical on every
+// instruction set"). Internal to sim/contact.
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+#include "sim/contact/shell_transfer.h"
+#include "sim/contact/site_dots.h"
+#include "sim/mpm/apic_stencil.h"
+
+namespace shellmpm::shell_blocks {
+
+#define SHELLMPM_BLOCKS_INLINE [[gnu::always_inline]] inline
+
+/// Slice of block b's order entries holding shell points of one kind: [lo, hi). (The
+/// functions here take grid.order() as `order`: its check would make the per-ISA objects
+/// define the exception's inline members.)
+SHELLMPM_BLOCKS_INLINE std::pair<std::uint32_t, std::uint32_t> slice(const SparseGrid& grid,
+                                                                     const std::uint32_t* o,
+                                                                     std::size_t b,
+                                                                     std::uint32_t lo_index,
+                                                                     std::uint32_t hi_index) {
+  const std::uint32_t s0 = grid.pblock_start[b], s1 = grid.pblock_start[b + 1];
+  const auto lo = std::lower_bound(o + s0, o + s1, lo_index) - o;
+  const auto hi = std::lower_bound(o + lo, o + s1, hi_index) - o;
+  return {static_cast<std::uint32_t>(lo), static_cast<std::uint32_t>(hi)};
+}
+
+/// Up to kSiteLanes contact sites of a particle block whose gradient dots are taken
+/// together: their table slots, weights, node masses (from the block's pad) and a3E.
+struct SiteBatch {
+  int n = 0;
+  std::uint32_t slot[kSiteLanes];
+  QuadraticWeights W[kSiteLanes];
+  SiteLaneInputs in;
+  alignas(32) Real dots[27][kSiteLanes];
+  bool any[kSiteLanes];
+  /// Adds site `slot` at grid coordinates g with normal column a3e; true when the batch
+  /// is full.
+  SHELLMPM_BLOCKS_INLINE bool add(std::uint32_t s, const Vec3& g, const Vec3& a3e, const Vec3i& bc,
+                                  const GridNode* pad) {
+    slot[n] = s;
+    W[n] = QuadraticWeights(g);
+    in.set(n, W[n], a3e);
+    int k = 0;
+    for_each_stencil_node(W[n], bc, [&](const StencilNode& nd) { in.m[k++][n] = pad[nd.pad()].m; });
+    return ++n == kSiteLanes;
+  }
+};
+
+/// Calls f(g, W, dots, j) for the contact sites in slots [lo, hi) of a particle block
+/// (corner bc, node masses in pad), in slot order, their gradient dots with a3E taken
+/// kSiteLanes at a time (weighted: g_n . a3E, else without the factor a_n): dots[k][j]
+/// for stencil node k; g is the site's point in the table. Sites where skip(g) and sites
+/// without a node with mass are left out.
+template <class Skip, class F>
+SHELLMPM_BLOCKS_INLINE void for_each_site_dots(const SparseGrid& grid, const std::uint32_t* order,
+                                               const ShellPointTable& table,
+                                               const std::vector<GridShell>& shells,
+                                               std::uint32_t lo, std::uint32_t hi, const Vec3i& bc,
+                                               const GridNode* pad, bool weighted, Skip skip, F f) {
+  const Real dx = static_cast<Real>(grid.dx());
+  SiteBatch batch;
+  auto flush = [&]() {
+    site_dots::dots_lanes<site_dots::Lanes>(batch.in, batch.n, dx, weighted, batch.dots, batch.any);
+    for (int i = 0; i < batch.n; ++i)
+      if (batch.any[i]) f(order[batch.slot[i]], batch.W[i], batch.dots, i);
+    batch.n = 0;
+  };
+  for (std::uint32_t s = lo; s < hi; ++s) {
+    const std::uint32_t g = order[s];
+    if (skip(g)) continue;
+    const ShellContact& c = *shells[table.shell(g)].contact;
+    const std::uint32_t p = table.local(g);
+    if (batch.add(s, grid.grid_coord(c.x[p]), c.a3e[p], bc, pad)) flush();
+  }
+  if (batch.n) flush();
+}
+
+/// shell_p2g_block's loop.
+SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* order,
+                                const ShellPointTable& table, const std::vector<GridShell>& shells,
+                                Real dt, std::size_t b, GridNode* buf) {
+  const auto [lo, hi] = slice(grid, order, b, 0, table.num_control_points());
+  if (lo == hi) return;
+  const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
+  const Real dx = static_cast<Real>(grid.dx());
+  for (std::uint32_t s = lo; s < hi; ++s) {
+    const std::uint32_t g = order[s];
+    const GridShell& gs = shells[table.shell(g)];
+    const std::uint32_t j = table.local(g);
+    const ShellObject& sh = *gs.shell;
+    const Real m = sh.mass[j];
+    const QuadraticWeights W(grid.grid_coord(sh.x[j]));
+    const Mat3 A = (m * dx) * gs.contact->C[j];  // world offset = dx (node - fx)
+    const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
+    apic_scatter<false>(buf, W, bc, m, m * sh.v[j] + dt * gs.force[j] - A * fx, A, Mat3::Zero());
+  }
+}
+
+/// shell_g2p_block's loop.
+SHELLMPM_BLOCKS_INLINE void g2p(const SparseGrid& grid, const std::uint32_t* order,
+                                const ShellPointTable& table, std::vector<GridShell>& shells,
+                                Real dt, std::size_t b, const GridNode* buf) {
+  const std::uint32_t nc = table.num_control_points();
+  const auto [lo, hi] = slice(grid, order, b, 0, static_cast<std::uint32_t>(table.size()));
+  if (lo == hi) return;
+  const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
+  const Real dx = static_cast<Real>(grid.dx());
+  // The block's control points come first in its slice (the order ascends within a block).
+  std::uint32_t s = lo;
+  for (; s < hi && order[s] < nc; ++s) {
+    const std::uint32_t g = order[s];
+    GridShell& gs = shells[table.shell(g)];
+    const std::uint32_t j = table.local(g);
+    ShellObject& sh = *gs.shell;
+    const QuadraticWeights W(grid.grid_coord(sh.x[j]));
+    const ApicGather G = apic_gather<false>(buf, W, bc);
+    const Vec3& v = G.v;
+    gs.contact->C[j] = (Real(4) / dx) * G.B;  // B D^-1 with B in grid units times dx
+    const std::uint8_t held = gs.held[j];
+    for (int a = 0; a < 3; ++a)
+      if (!(held & (1u << a))) sh.v[j][a] = v[a];
+    sh.x[j] += dt * sh.v[j];
+  }
+  // Contact particles, their gradient dots kSiteLanes at a time: grad~v a3E =
+  // sum_n v_n (g_n . a3E) (nodes without mass have g_n = 0), summed over the stencil rows
+  // as (m, v) per node (the velocity is lanes 1..3).
+  for_each_site_dots(
+      grid, order, table, shells, s, hi, bc, buf, true, [](std::uint32_t) { return false; },
+      [&](std::uint32_t g, const QuadraticWeights& W, const Real(&ga)[27][kSiteLanes], int lane) {
+        using namespace stencil_row;
+        const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+        Row sum = zero();
+        int k = 0;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j, k += 3) {
+            const Real g3[3] = {ga[k][lane], ga[k + 1][lane], ga[k + 2][lane]};
+            sum = sum + per_node(g3) * load(&buf[pad_node(lx + i, ly + j, lz)]);
+          }
+        alignas(16) Real v[4];
+        node_sum(sum, v);
+        ShellContact& c = *shells[table.shell(g)].contact;
+        c.a3e[table.local(g)] += dt * Vec3(v[1], v[2], v[3]);
+      });
+}
+
+/// The normal forces of block b's contact sites [lo, hi) (contact_normal_forces): node
+/// masses from pad, velocity increments added into inc. Returns whether any site added.
+SHELLMPM_BLOCKS_INLINE bool normal_forces(const SparseGrid& grid, const std::uint32_t* order,
+                                          const ShellPointTable& table,
+                                          const std::vector<GridShell>& shells, Real dt,
+                                          std::size_t b, std::uint32_t lo, std::uint32_t hi,
+                                          const GridNode* pad, GridNode* inc) {
+  bool added = false;
+  const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
+  for_each_site_dots(
+      grid, order, table, shells, lo, hi, bc, pad, false,
+      [&](std::uint32_t g) {  // separated without shear: no force
+        return shells[table.shell(g)].contact->G3[table.local(g)].squaredNorm() == 0;
+      },
+      [&](std::uint32_t g, const QuadraticWeights& W, const Real(&t)[27][kSiteLanes], int lane) {
+        using namespace stencil_row;
+        const ShellContact& c = *shells[table.shell(g)].contact;
+        const std::uint32_t p = table.local(g);
+        // dt f_n / m_n = -dt V (g_n . a3E) / m_n G3 with g_n / m_n = w_n Minv (d_n - dbar):
+        // w_n t_n (0, S) per node with mass, t_n = (d_n - dbar) . Minv^T a3E,
+        // S = -dt V G3.
+        const Row S = splat(Real(0), (-dt * c.volume[p]) * c.G3[p]);
+        const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+        int k = 0;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) {
+            const int row = pad_node(lx + i, ly + j, lz);
+            Real f[3];
+            for (int l = 0; l < 3; ++l, ++k)
+              f[l] =
+                  pad[row + l].m > 0 ? (W.w[0][i] * W.w[1][j] * W.w[2][l]) * t[k][lane] : Real(0);
+            store(&inc[row], load(&inc[row]) + per_node(f) * S);
+          }
+        added = true;
+      });
+  return added;
+}
+
+/// The per-ISA entry points (shell_blocks_avx2.cpp, shell_blocks_avx512.cpp).
+#define SHELLMPM_SHELL_BLOCKS_DECLARE(isa)                                                         \
+  void p2g_##isa(const SparseGrid& grid, const std::uint32_t* order, const ShellPointTable& table, \
+                 const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf);     \
+  void g2p_##isa(const SparseGrid& grid, const std::uint32_t* order, const ShellPointTable& table, \
+                 std::vector<GridShell>& shells, Real dt, std::size_t b, const GridNode* buf);     \
+  bool normal_forces_##isa(const SparseGrid& grid, const std::uint32_t* order,                     \
+                           const ShellPointTable& table, const std::vector<GridShell>& shells,     \
+                           Real dt, std::size_t b, std::uint32_t lo, std::uint32_t hi,             \
+                           const GridNode* pad, GridNode* inc);
+SHELLMPM_SHELL_BLOCKS_DECLARE(avx2)
+SHELLMPM_SHELL_BLOCKS_DECLARE(avx512)
+
+}  // namespace shellmpm::shell_blocks
+
+#define SHELLMPM_SHELL_BLOCKS_ENTRIES(isa)                                                        \
+  namespace shellmpm::shell_blocks {                                                              \
+  __attribute__((flatten)) void p2g_##isa(const SparseGrid& grid, const std::uint32_t* order,     \
+                                          const ShellPointTable& table,                           \
+                                          const std::vector<GridShell>& shells, Real dt,          \
+                                          std::size_t b, GridNode* buf) {                         \
+    p2g(grid, order, table, shells, dt, b, buf);                                                  \
+  }                                                                                               \
+  __attribute__((flatten)) void g2p_##isa(const SparseGrid& grid, const std::uint32_t* order,     \
+                                          const ShellPointTable& table,                           \
+                                          std::vector<GridShell>& shells, Real dt, std::size_t b, \
+                                          const GridNode* buf) {                                  \
+    g2p(grid, order, table, shells, dt, b, buf);                                                  \
+  }                                                                                               \
+  __attribute__((flatten)) bool normal_forces_##isa(                                              \
+      const SparseGrid& grid, const std::uint32_t* order, const ShellPointTable& table,           \
+      const std::vector<GridShell>& shells, Real dt, std::size_t b, std::uint32_t lo,             \
+      std::uint32_t hi, const GridNode* pad, GridNode* inc) {                                     \
+    return normal_forces(grid, order, table, shells, dt, b, lo, hi, pad, inc);                    \
+  }                                                                                               \
+  }
