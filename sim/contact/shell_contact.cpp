@@ -14,6 +14,12 @@ constexpr std::size_t kGrain = 2048;
 constexpr Real kCompressionTolerance = Real(1e-4);
 constexpr Real kSeparationTolerance = Real(1e-6);
 
+/// A Vec3 as (x, y, z, 0) in one vector (the stencil sums run on these).
+typedef Real R4 __attribute__((vector_size(4 * sizeof(Real))));
+inline void load3(const Vec3& v, R4& out) {
+  out = R4{v[0], v[1], v[2], Real(0)};
+}
+
 }  // namespace
 
 ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& rest, double thickness,
@@ -91,17 +97,20 @@ void ShellContact::tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2)
 
 void ShellContact::position_and_tangents(const Vec3* ctrl, std::size_t p, Vec3& xp, Vec3& a1,
                                          Vec3& a2) const {
-  const Vec3 ref = ctrl[idx[off[p]]];
-  Vec3 d = Vec3::Zero();
-  a1.setZero();
-  a2.setZero();
+  // Each sum on a 4-vector (x, y, z, 0): per component the operations of the Vec3 form.
+  R4 ref, d = {}, t1 = {}, t2 = {};
+  load3(ctrl[idx[off[p]]], ref);
   for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
-    const Vec3 dk = ctrl[idx[k]] - ref;
+    R4 c;
+    load3(ctrl[idx[k]], c);
+    const R4 dk = c - ref;
     d += N[k] * dk;
-    a1 += N1[k] * dk;
-    a2 += N2[k] * dk;
+    t1 += N1[k] * dk;
+    t2 += N2[k] * dk;
   }
-  xp = ref + d;
+  xp = Vec3(ref[0] + d[0], ref[1] + d[1], ref[2] + d[2]);
+  a1 = Vec3(t1[0], t1[1], t1[2]);
+  a2 = Vec3(t2[0], t2[1], t2[2]);
 }
 
 void ShellContact::update_positions(const Vec3* ctrl, bool serial) {
