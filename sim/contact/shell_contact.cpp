@@ -176,7 +176,7 @@ double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
               gl.a3e[c][j] = a3e[p][c];
             }
           }
-          gl.run(params_);
+          contact_lanes::gradients(gl, params_);
           for (int j = 0; j < n; ++j) {
             const std::size_t p = p0 + static_cast<std::size_t>(j);
             const Real V = volume[p];
@@ -209,27 +209,6 @@ double ShellContact::energy(const Vec3* ctrl, bool serial) const {
     return static_cast<double>(volume[p] *
                                contact_gradient<Real>(a1, a2, a3e[p], params_, nullptr));
   });
-}
-
-void ShellContact::FrameLanes::run() {
-  D r11, r12, r22;
-  contact_frame_parts(
-      a1, a2, a3e,
-      [](D& x) {
-        for (int j = 0; j < kFrameLanes; ++j) x[j] = std::sqrt(x[j]);
-      },
-      q, r11, r12, r22, s);
-}
-
-void ShellContact::GradientLanes::run(const ContactParams& params) {
-  R q[3][3], r11, r12, r22, s[3];
-  contact_frame_parts(
-      a1, a2, a3e,
-      [](R& v) {
-        for (int j = 0; j < kFrameLanes; ++j) v[j] = std::sqrt(v[j]);
-      },
-      q, r11, r12, r22, s);
-  contact_gradient_parts<Real>(q, r11, r12, r22, s, params, psi, g);
 }
 
 ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const FrameLanes& fl,
@@ -297,7 +276,7 @@ ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
               fl.a3e[c][j] = static_cast<double>(a3e[p][c]);
             }
           }
-          fl.run();
+          contact_lanes::frames(fl);
           for (int j = 0; j < n; ++j) acc += return_map_site(p0 + std::size_t(j), fl, j);
         }
         return acc;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim/contact/contact_energy.h"
+#include "sim/contact/contact_lanes.h"
 #include "sim/contact/friction_return_map.h"
 #include "sim/core/types.h"
 #include "sim/shell/loop_basis.h"
@@ -78,25 +79,9 @@ class ShellContact {
       return *this;
     }
   };
-  /// contact_frame in double for kFrameLanes sites, one per lane of a GCC vector
-  /// (contact_frame_parts): inputs a1, a2, a3e and outputs the frame q and s, each
-  /// [component][lane] (q[i][component][lane]).
-  static constexpr int kFrameLanes = 8;
-  struct FrameLanes {
-    typedef double D __attribute__((vector_size(kFrameLanes * sizeof(double))));
-    D a1[3], a2[3], a3e[3];
-    D q[3][3], s[3];
-    void run();
-  };
-  /// contact_gradient for kFrameLanes sites, one per lane (contact_frame_parts and
-  /// contact_gradient_parts, so each lane has the bits of the site alone): inputs a1, a2,
-  /// a3e, outputs psi and G (g[column][component][lane]).
-  struct GradientLanes {
-    typedef Real R __attribute__((vector_size(kFrameLanes * sizeof(Real))));
-    R a1[3], a2[3], a3e[3];
-    R psi, g[3][3];
-    void run(const ContactParams& params);
-  };
+  static constexpr int kFrameLanes = contact_lanes::kLanes;
+  using FrameLanes = contact_lanes::FrameLanes;
+  using GradientLanes = contact_lanes::GradientLanes;
   /// The return mapping of site p with its frame in lane j of fl.
   ReturnMapSums return_map_site(std::size_t p, const FrameLanes& fl, int j);
 

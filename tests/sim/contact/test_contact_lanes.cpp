@@ -1,11 +1,14 @@
-// Contact gradients of several sites at once (contact_gradient_parts on GCC vector lanes,
-// ShellContact::forces eight sites at a time) against one site alone: the same bits.
+// Contact gradients and frames of several sites at once (contact_lanes.h, on every
+// instruction set; ShellContact::forces eight sites at a time) against one site alone:
+// the same bits.
 #include <catch2/catch.hpp>
 
 #include <cstring>
 #include <random>
 
+#include "sim/contact/contact_lanes.h"
 #include "sim/contact/shell_contact.h"
+#include "sim/mpm/stress_batch.h"
 #include "sim/shell/procedural_mesh.h"
 
 using namespace shellmpm;
@@ -26,43 +29,59 @@ bool same_bits(Real a, Real b) {
 
 }  // namespace
 
-TEST_CASE("contact gradient on lanes gives each lane the bits of its site alone", "[contact]") {
-  constexpr int L = 8;
-  typedef Real R __attribute__((vector_size(L * sizeof(Real))));
+TEST_CASE(
+    "contact gradients and frames on lanes give each lane the bits of its site alone, on "
+    "every instruction set",
+    "[contact]") {
+  using namespace contact_lanes;
   std::mt19937 rng(5);
   std::uniform_real_distribution<Real> u(-1, 1);
-  R a1[3], a2[3], a3[3];
-  Vec3 b1[L], b2[L], b3[L];
-  for (int j = 0; j < L; ++j) {
+  GradientLanes in;
+  FrameLanes fin;
+  Vec3 b1[kLanes], b2[kLanes], b3[kLanes];
+  for (int j = 0; j < kLanes; ++j) {
     // Compressed, separated and exactly at rest length (s3 = 1) sites, with shear.
     const Real s3 = j % 3 == 0 ? Real(0.7) + Real(0.2) * u(rng) : (j % 3 == 1 ? Real(1.1) : 1);
     b1[j] = Vec3(Real(1.1) + Real(0.1) * u(rng), Real(0.1) * u(rng), Real(0.1) * u(rng));
     b2[j] = Vec3(Real(0.2) * u(rng), Real(0.9), Real(0.1) * u(rng));
     b3[j] = Vec3(Real(0.2) * u(rng), Real(0.2) * u(rng), s3);
     for (int c = 0; c < 3; ++c) {
-      a1[c][j] = b1[j][c];
-      a2[c][j] = b2[j][c];
-      a3[c][j] = b3[j][c];
+      in.a1[c][j] = b1[j][c];
+      in.a2[c][j] = b2[j][c];
+      in.a3e[c][j] = b3[j][c];
+      fin.a1[c][j] = b1[j][c];
+      fin.a2[c][j] = b2[j][c];
+      fin.a3e[c][j] = b3[j][c];
     }
   }
-  R q[3][3], r11, r12, r22, s[3], psi, g[3][3];
-  contact_frame_parts(
-      a1, a2, a3,
-      [](R& v) {
-        for (int j = 0; j < L; ++j) v[j] = std::sqrt(v[j]);
-      },
-      q, r11, r12, r22, s);
-  contact_gradient_parts<Real>(q, r11, r12, r22, s, params(), psi, g);
-  int compressed = 0;
-  for (int j = 0; j < L; ++j) {
-    Mat3 G;
-    const Real psi1 = contact_gradient<Real>(b1[j], b2[j], b3[j], params(), &G);
-    compressed += s[2][j] < 1;
-    CHECK(same_bits(psi[j], psi1));
-    for (int c = 0; c < 3; ++c)
-      for (int i = 0; i < 3; ++i) CHECK(same_bits(g[c][i][j], G(i, c)));
+  struct Restore {
+    SimdLevel saved = simd_level();
+    ~Restore() { set_simd_level(saved); }
+  } restore;
+  for (int level = 0; level <= static_cast<int>(simd_supported()); ++level) {
+    set_simd_level(static_cast<SimdLevel>(level));
+    INFO(simd_name(static_cast<SimdLevel>(level)));
+    GradientLanes g = in;
+    gradients(g, params());
+    FrameLanes f = fin;
+    frames(f);
+    int compressed = 0;
+    for (int j = 0; j < kLanes; ++j) {
+      Mat3 G;
+      const Real psi1 = contact_gradient<Real>(b1[j], b2[j], b3[j], params(), &G);
+      compressed += G.col(2).norm() > Real(1e3);
+      CHECK(same_bits(g.psi[j], psi1));
+      for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < 3; ++i) CHECK(same_bits(g.g[c][i][j], G(i, c)));
+      const ContactFrameT<double> fr =
+          contact_frame<double>(b1[j].cast<double>(), b2[j].cast<double>(), b3[j].cast<double>());
+      for (int i = 0; i < 3; ++i) {
+        CHECK(f.s[i][j] == fr.s[i]);
+        for (int c = 0; c < 3; ++c) CHECK(f.q[i][c][j] == fr.q[i][c]);
+      }
+    }
+    CHECK(compressed >= 2);  // both branches of f(s3) are exercised
   }
-  CHECK(compressed >= 2);  // both branches of f(s3) are exercised
 }
 
 namespace {
