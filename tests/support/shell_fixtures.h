@@ -2,9 +2,20 @@
 #pragma once
 #include <string>
 
+#include "sim/contact/contact_energy.h"
 #include "sim/scene/scene.h"
 
 namespace shellmpm::test {
+
+/// The contact material of the single-particle contact tests: k_c 2e5 Pa, gamma 5e4 Pa,
+/// c_F 0.4.
+inline ContactParams contact_params() {
+  ContactParams p;
+  p.kc = 2.0e5;
+  p.gamma = 5.0e4;
+  p.friction = 0.4;
+  return p;
+}
 
 /// A light cotton-like cloth: E 2e5 Pa, nu 0.3, 300 kg/m^3, 1 mm.
 inline ShellMaterialDesc cloth_material() {

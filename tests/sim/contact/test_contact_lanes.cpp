@@ -10,17 +10,14 @@
 #include "sim/contact/shell_contact.h"
 #include "sim/mpm/stress_batch.h"
 #include "sim/shell/procedural_mesh.h"
+#include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;
 
 namespace {
 
 ContactParams params() {
-  ContactParams p;
-  p.kc = 2.0e5;
-  p.gamma = 5.0e4;
-  p.friction = 0.4;
-  return p;
+  return test::contact_params();
 }
 
 bool same_bits(Real a, Real b) {

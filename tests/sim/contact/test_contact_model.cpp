@@ -6,6 +6,7 @@
 
 #include "sim/contact/contact_energy.h"
 #include "sim/contact/friction_return_map.h"
+#include "tests/support/shell_fixtures.h"
 
 using namespace shellmpm;
 using V3 = Eigen::Vector3d;
@@ -14,11 +15,7 @@ using M3 = Eigen::Matrix3d;
 namespace {
 
 ContactParams params() {
-  ContactParams p;
-  p.kc = 2.0e5;
-  p.gamma = 5.0e4;
-  p.friction = 0.4;
-  return p;
+  return test::contact_params();
 }
 
 // A random deformed site: tangents near an orthogonal frame, a3E compressed (s3 in
