@@ -83,21 +83,14 @@ ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& res
 }
 
 void ShellContact::tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2) const {
-  // Differences to the first control point: the dN sum to zero, so this is exact and
-  // keeps float precision far from the origin.
-  const Vec3 ref = ctrl[idx[off[p]]];
-  a1.setZero();
-  a2.setZero();
-  for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
-    const Vec3 d = ctrl[idx[k]] - ref;
-    a1 += N1[k] * d;
-    a2 += N2[k] * d;
-  }
+  Vec3 xp;
+  position_and_tangents(ctrl, p, xp, a1, a2);
 }
 
 void ShellContact::position_and_tangents(const Vec3* ctrl, std::size_t p, Vec3& xp, Vec3& a1,
                                          Vec3& a2) const {
-  // Each sum on a 4-vector (x, y, z, 0): per component the operations of the Vec3 form.
+  // Differences to the first control point: the dN sum to zero, so this is exact and
+  // keeps float precision far from the origin. Each sum on a 4-vector (x, y, z, 0).
   R4 ref, d = {}, t1 = {}, t2 = {};
   load3(ctrl[idx[off[p]]], ref);
   for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {

@@ -237,8 +237,8 @@ struct SiteLaneInputs {
 /// For the first n <= kSiteLanes sites of `in` at once, one per lane: out[k][j] =
 /// site_moments(site j).offsets_dot(u_j)[k], or .dot(u_j)[k] when `weighted`, the same
 /// bits; any[j] = its moments' `any` (out unset where false). Lanes n.. of `in` are
-/// overwritten. Runs on the widest instruction set simd_level() allows
-/// (sim/contact/site_dots.h).
+/// overwritten. (sim/contact/site_dots.h; the shells' transfers run its per-ISA
+/// instances, shell_blocks.h.)
 void site_dots_batch(SiteLaneInputs& in, int n, Real dx, bool weighted, Real (&out)[27][kSiteLanes],
                      bool (&any)[kSiteLanes]);
 

@@ -4,12 +4,12 @@
 // times a_n (SiteMoments::dot), one site per lane. The sites' G2P (u = a3E, weighted) and
 // normal forces (u = a3E, unweighted) use them.
 //
-// The library compiles the body for x86-64-v2 (site_dots.cpp, the 8 lanes in two SSE
-// registers); site_dots_avx2.cpp and site_dots_avx512.cpp compile it for AVX2 and
-// AVX-512 (one register), with no contraction into fused multiply-adds, and
-// site_dots_batch picks one at run time (simd_level()). Every lane does the same IEEE
-// operations as site_moments and offsets_dot on one site, so all three give those bits
-// (tests/sim/contact/test_site_moments.cpp). Internal to sim/contact.
+// The body is inlined into the shells' per-block loops, which are compiled for SSE, AVX2
+// and AVX-512 (shell_blocks.h); site_dots_batch is the library's (x86-64-v2) instance.
+// Every lane does the same IEEE operations as site_moments and offsets_dot on one site,
+// with no contraction into fused multiply-adds, so every instance gives those bits
+// (tests/sim/contact/test_site_moments.cpp; across instruction sets through the shells'
+// transfers, test_contact_solver.cpp). Internal to sim/contact.
 #pragma once
 #include <cstring>
 
@@ -63,18 +63,4 @@ template <class F>
 
 typedef Real Lanes __attribute__((vector_size(kSiteLanes * sizeof(Real))));
 
-/// The per-ISA entry points (site_dots_avx2.cpp, site_dots_avx512.cpp).
-void dots_avx2(SiteLaneInputs& in, int n, Real dx, bool weighted, Real (&out)[27][kSiteLanes],
-               bool (&any)[kSiteLanes]);
-void dots_avx512(SiteLaneInputs& in, int n, Real dx, bool weighted, Real (&out)[27][kSiteLanes],
-                 bool (&any)[kSiteLanes]);
-
 }  // namespace shellmpm::site_dots
-
-#define SHELLMPM_SITE_DOTS_ENTRY(isa)                                                              \
-  namespace shellmpm::site_dots {                                                                  \
-  __attribute__((flatten)) void dots_##isa(SiteLaneInputs& in, int n, Real dx, bool weighted,      \
-                                           Real (&out)[27][kSiteLanes], bool (&any)[kSiteLanes]) { \
-    dots_lanes<Lanes>(in, n, dx, weighted, out, any);                                              \
-  }                                                                                                \
-  }

@@ -1,6 +1,7 @@
 // The contact sites' mass-weighted gradient moments (sim/contact/shell_transfer.h):
-// site_dots_batch (eight sites at once, on every instruction set) against one site at a
-// time, and the gradient's exactness for linear velocity fields.
+// site_dots_batch (eight sites at once, with every instruction-set level set; the per-ISA
+// instances inside the shells' transfers are compared in test_contact_solver.cpp) against
+// one site at a time, and the gradient's exactness for linear velocity fields.
 #include <catch2/catch.hpp>
 
 #include <cstring>
