@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -71,6 +72,8 @@ SHELLMPM_BLOCKS_INLINE void for_each_site_dots(const SparseGrid& grid, const std
                                                std::uint32_t lo, std::uint32_t hi, const Vec3i& bc,
                                                const GridNode* pad, bool weighted, Skip skip, F f) {
   const Real dx = static_cast<Real>(grid.dx());
+  const bool forces = !weighted;
+  constexpr std::uint32_t kAhead = 8;
   SiteBatch batch;
   auto flush = [&]() {
     site_dots::dots_lanes<site_dots::Lanes>(batch.in, batch.n, dx, weighted, batch.dots, batch.any);
@@ -79,6 +82,17 @@ SHELLMPM_BLOCKS_INLINE void for_each_site_dots(const SparseGrid& grid, const std
     batch.n = 0;
   };
   for (std::uint32_t s = lo; s < hi; ++s) {
+    if (s + kAhead < hi) {
+      const std::uint32_t ga = order[s + kAhead];
+      const ShellContact& ca = *shells[table.shell(ga)].contact;
+      const std::uint32_t pa = table.local(ga);
+      __builtin_prefetch(&ca.x[pa]);
+      __builtin_prefetch(&ca.a3e[pa]);
+      if (forces) {
+        __builtin_prefetch(&ca.G3[pa]);
+        __builtin_prefetch(&ca.volume[pa]);
+      }
+    }
     const std::uint32_t g = order[s];
     if (skip(g)) continue;
     const ShellContact& c = *shells[table.shell(g)].contact;
@@ -88,14 +102,86 @@ SHELLMPM_BLOCKS_INLINE void for_each_site_dots(const SparseGrid& grid, const std
   if (batch.n) flush();
 }
 
+/// A node of a padded buffer of fold heights: the mass, the least height and minus the
+/// greatest (so that one min keeps both), and a spare lane.
+struct HeightsPadNode {
+  Real m, hmin, nhmax, spare;
+};
+/// Three such nodes, a stencil row (i, j, 0..2), in lanes 4k .. 4k + 3, and in lanes
+/// 12..15 the buffer's next node, passed through unchanged.
+typedef Real HeightsRow __attribute__((vector_size(16 * sizeof(Real))));
+
+/// A control point's fold heights (shell_p2g_block) into a padded buffer (one spare node
+/// past its end): the mass m with weight w at every stencil node, and the node's height
+/// over the point's tangent plane (unit normal n turned to align's side, at grid
+/// coordinate fx) where w > 0, the same IEEE operations as one node at a time.
+SHELLMPM_BLOCKS_INLINE void scatter_heights(HeightsPadNode* pad, const QuadraticWeights& W,
+                                            const Vec3i& bc, Real m, const Vec3& n,
+                                            const Vec3& align) {
+  using Mask = decltype(HeightsRow{} > HeightsRow{});
+  const Real sign = n.dot(align) >= 0 ? Real(1) : Real(-1);
+  const Real fx[3] = {W.fx[0], W.fx[1], W.fx[2]};
+  HeightsRow wz{}, hz{}, flip{};
+  Mask is_m{}, is_h{};
+  for (int k = 0; k < 3; ++k)
+    for (int c = 0; c < 4; ++c) {
+      wz[4 * k + c] = W.w[2][k];
+      hz[4 * k + c] = n[2] * (Real(k) - fx[2]);
+      flip[4 * k + c] = c == 2 ? Real(-1) : Real(1);
+      is_m[4 * k + c] = c == 0 ? -1 : 0;
+      is_h[4 * k + c] = c == 1 || c == 2 ? -1 : 0;
+    }
+  const HeightsRow none = HeightsRow{} + std::numeric_limits<Real>::infinity();
+  const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      // n . ((i, j, k) - fx), summed in this order (ShellFields::side_of).
+      const Real side_ij = n[0] * (Real(i) - fx[0]) + n[1] * (Real(j) - fx[1]);
+      const HeightsRow w = (W.w[0][i] * W.w[1][j]) * wz;
+      const HeightsRow h = sign * (side_ij + hz);
+      const HeightsRow cand = w > 0 ? h * flip : none;  // lanes 4k + 1: h, 4k + 2: -h
+      HeightsPadNode* row = pad + pad_node(lx + i, ly + j, lz);
+      HeightsRow a;
+      std::memcpy(&a, row, sizeof a);
+      const HeightsRow sum = a + w * m;
+      const HeightsRow low = cand < a ? cand : a;
+      a = is_m ? sum : (is_h ? low : a);
+      std::memcpy(row, &a, sizeof a);
+    }
+}
+
+/// Adds the nodes of particle block b's padded buffer of heights that its points reached
+/// into the grid's (FoldHeights::ready).
+SHELLMPM_BLOCKS_INLINE void merge_heights(const SparseGrid& grid, std::size_t b,
+                                          const HeightsPadNode* pad, FoldHeights& heights) {
+  grid.for_each_pad_node(b, [&](int gb, int bn, int pn) {
+    const HeightsPadNode& p = pad[pn];
+    if (p.m == 0 && p.hmin == std::numeric_limits<Real>::max()) return;  // not reached
+    const auto g = static_cast<std::size_t>(gb);
+    if (!heights.ready[g]) {
+      heights.blocks[g].fill(kNoHeights);
+      heights.ready[g] = 1;
+    }
+    NodeHeights& d = heights.blocks[g][bn];
+    d.m += p.m;
+    d.hmin = std::min(d.hmin, p.hmin);
+    d.hmax = std::max(d.hmax, -p.nhmax);
+  });
+}
+
 /// shell_p2g_block's loop.
 SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* order,
                                 const ShellPointTable& table, const std::vector<GridShell>& shells,
-                                Real dt, std::size_t b, GridNode* buf) {
+                                Real dt, std::size_t b, GridNode* buf, FoldHeights* heights) {
   const auto [lo, hi] = slice(grid, order, b, 0, table.num_control_points());
   if (lo == hi) return;
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
+  HeightsPadNode hpad[kPadNodes + 1];
+  if (heights)
+    std::fill(hpad, hpad + kPadNodes + 1,
+              HeightsPadNode{Real(0), std::numeric_limits<Real>::max(),
+                             std::numeric_limits<Real>::max(), Real(0)});
   for (std::uint32_t s = lo; s < hi; ++s) {
     const std::uint32_t g = order[s];
     const GridShell& gs = shells[table.shell(g)];
@@ -106,7 +192,9 @@ SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* ord
     const Mat3 A = (m * dx) * gs.contact->C[j];  // world offset = dx (node - fx)
     const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
     apic_scatter<false>(buf, W, bc, m, m * sh.v[j] + dt * gs.force[j] - A * fx, A, Mat3::Zero());
+    if (heights) scatter_heights(hpad, W, bc, m, heights->normal[j], heights->align);
   }
+  if (heights) merge_heights(grid, b, hpad, *heights);
 }
 
 /// shell_g2p_block's loop.
@@ -156,20 +244,20 @@ SHELLMPM_BLOCKS_INLINE void g2p(const SparseGrid& grid, const std::uint32_t* ord
       });
 }
 
-/// The normal forces of block b's contact sites [lo, hi) (contact_normal_forces): node
-/// masses from pad, velocity increments added into inc. Returns whether any site added.
+/// The normal forces of block b's contact sites [lo, hi) (contact_normal_forces), those g
+/// with push[g] (dpsi/da3E != 0): node masses from pad, velocity increments added into
+/// inc. Returns whether any site added.
 SHELLMPM_BLOCKS_INLINE bool normal_forces(const SparseGrid& grid, const std::uint32_t* order,
                                           const ShellPointTable& table,
-                                          const std::vector<GridShell>& shells, Real dt,
-                                          std::size_t b, std::uint32_t lo, std::uint32_t hi,
-                                          const GridNode* pad, GridNode* inc) {
+                                          const std::vector<GridShell>& shells,
+                                          const std::uint8_t* push, Real dt, std::size_t b,
+                                          std::uint32_t lo, std::uint32_t hi, const GridNode* pad,
+                                          GridNode* inc) {
   bool added = false;
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   for_each_site_dots(
       grid, order, table, shells, lo, hi, bc, pad, false,
-      [&](std::uint32_t g) {  // separated without shear: no force
-        return shells[table.shell(g)].contact->G3[table.local(g)].squaredNorm() == 0;
-      },
+      [&](std::uint32_t g) { return !push[g]; },  // separated without shear: no force
       [&](std::uint32_t g, const QuadraticWeights& W, const Real(&t)[27][kSiteLanes], int lane) {
         using namespace stencil_row;
         const ShellContact& c = *shells[table.shell(g)].contact;
@@ -197,13 +285,14 @@ SHELLMPM_BLOCKS_INLINE bool normal_forces(const SparseGrid& grid, const std::uin
 /// The per-ISA entry points (shell_blocks_avx2.cpp, shell_blocks_avx512.cpp).
 #define SHELLMPM_SHELL_BLOCKS_DECLARE(isa)                                                         \
   void p2g_##isa(const SparseGrid& grid, const std::uint32_t* order, const ShellPointTable& table, \
-                 const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf);     \
+                 const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf,      \
+                 FoldHeights* heights);                                                            \
   void g2p_##isa(const SparseGrid& grid, const std::uint32_t* order, const ShellPointTable& table, \
                  std::vector<GridShell>& shells, Real dt, std::size_t b, const GridNode* buf);     \
   bool normal_forces_##isa(const SparseGrid& grid, const std::uint32_t* order,                     \
                            const ShellPointTable& table, const std::vector<GridShell>& shells,     \
-                           Real dt, std::size_t b, std::uint32_t lo, std::uint32_t hi,             \
-                           const GridNode* pad, GridNode* inc);
+                           const std::uint8_t* push, Real dt, std::size_t b, std::uint32_t lo,     \
+                           std::uint32_t hi, const GridNode* pad, GridNode* inc);
 SHELLMPM_SHELL_BLOCKS_DECLARE(avx2)
 SHELLMPM_SHELL_BLOCKS_DECLARE(avx512)
 
@@ -214,8 +303,8 @@ SHELLMPM_SHELL_BLOCKS_DECLARE(avx512)
   __attribute__((flatten)) void p2g_##isa(const SparseGrid& grid, const std::uint32_t* order,     \
                                           const ShellPointTable& table,                           \
                                           const std::vector<GridShell>& shells, Real dt,          \
-                                          std::size_t b, GridNode* buf) {                         \
-    p2g(grid, order, table, shells, dt, b, buf);                                                  \
+                                          std::size_t b, GridNode* buf, FoldHeights* heights) {   \
+    p2g(grid, order, table, shells, dt, b, buf, heights);                                         \
   }                                                                                               \
   __attribute__((flatten)) void g2p_##isa(const SparseGrid& grid, const std::uint32_t* order,     \
                                           const ShellPointTable& table,                           \
@@ -225,8 +314,8 @@ SHELLMPM_SHELL_BLOCKS_DECLARE(avx512)
   }                                                                                               \
   __attribute__((flatten)) bool normal_forces_##isa(                                              \
       const SparseGrid& grid, const std::uint32_t* order, const ShellPointTable& table,           \
-      const std::vector<GridShell>& shells, Real dt, std::size_t b, std::uint32_t lo,             \
-      std::uint32_t hi, const GridNode* pad, GridNode* inc) {                                     \
-    return normal_forces(grid, order, table, shells, dt, b, lo, hi, pad, inc);                    \
+      const std::vector<GridShell>& shells, const std::uint8_t* push, Real dt, std::size_t b,     \
+      std::uint32_t lo, std::uint32_t hi, const GridNode* pad, GridNode* inc) {                   \
+    return normal_forces(grid, order, table, shells, push, dt, b, lo, hi, pad, inc);              \
   }                                                                                               \
   }

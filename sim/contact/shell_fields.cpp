@@ -1,10 +1,12 @@
 #include "sim/contact/shell_fields.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 
 #include "sim/contact/field_contact.h"
+#include "sim/core/check.h"
 #include "sim/core/parallel.h"
 #include "sim/mpm/apic_stencil.h"
 
@@ -86,26 +88,7 @@ void ShellFields::normalise(Node& d) {
     }
 }
 
-void ShellFields::shell_p2g_heights(Field& F, const GridShell& gs, Real dt, bool serial) {
-  const std::size_t ng = F.grid.num_grid_blocks();
-  F.heights.resize(ng);
-  parallel_for_each(
-      ng, 16,
-      [&](std::size_t g) {
-        F.heights[g].fill(
-            {Real(0), std::numeric_limits<Real>::max(), std::numeric_limits<Real>::lowest()});
-        F.r[g].fill(Vec3::Zero());
-      },
-      serial);
-  scatter_shares<HeightShare>(F, gs, dt, true, serial,
-                              [&](const HeightShare& P, const HeightShare::Row& r, int g, int node,
-                                  Real w, int k) { P.add(F.heights[g][node], w, r, k); });
-}
-
-void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial) {
-  const ShellObject& sh = *gs.shell;
-  F.x0 = sh.x;
-  // Control-point normals: area-weighted normals of the control mesh's triangles.
+void ShellFields::control_normals(Field& F, const ShellObject& sh) {
   F.normal.assign(sh.size(), Vec3::Zero());
   for (const Eigen::Vector3i& t : sh.triangles()) {
     const Vec3 a = (sh.x[t[1]] - sh.x[t[0]]).cross(sh.x[t[2]] - sh.x[t[0]]);
@@ -115,23 +98,79 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial)
     const Real l = n.norm();
     n = l > 0 ? Vec3(n / l) : Vec3::Zero();
   }
-  F.grid.bin(sh.x, serial);
-  const std::size_t ng = F.grid.num_grid_blocks();
-  F.nodes.resize(ng);
-  F.r.resize(ng);
+}
+
+FoldHeights* ShellFields::begin_p2g(const SparseGrid& combined,
+                                    const std::vector<GridShell>& shells) {
+  if (!heights_only_) return nullptr;
+  control_normals(fields_[0], *shells[0].shell);
+  heights_.normal = fields_[0].normal.data();
+  heights_.align = kAlign;
+  heights_.blocks.resize(combined.num_grid_blocks());  // set where points reach them
+  heights_.ready.assign(combined.num_grid_blocks(), 0);
+  return &heights_;
+}
+
+bool ShellFields::any_spread(bool serial) const {
+  std::atomic<bool> found{false};
+  parallel_for_each(
+      heights_.blocks.size(), 64,
+      [&](std::size_t g) {
+        if (!heights_.ready[g] || found.load(std::memory_order_relaxed)) return;
+        for (const NodeHeights& d : heights_.blocks[g])
+          if (spreads(d)) {
+            found.store(true, std::memory_order_relaxed);
+            return;
+          }
+      },
+      serial);
+  return found.load();
+}
+
+void ShellFields::shell_p2g(Field& F, const GridShell& gs, const SparseGrid& combined, Real dt,
+                            bool serial) {
+  const ShellObject& sh = *gs.shell;
   if (heights_only_) {
-    shell_p2g_heights(F, gs, dt, serial);
+    // The combined P2G summed the heights (begin_p2g, shell_p2g_block). Where none spreads
+    // the shell has no fold: one body at every node, the field stays empty.
+    F.folds.clear();
+    if (!any_spread(serial)) {
+      F.fold.clear();
+      return;
+    }
+    F.x0 = sh.x;
+    F.grid.bin(sh.x, serial);
+    const std::size_t ng = F.grid.num_grid_blocks();
+    F.nodes.resize(ng);
+    F.r.resize(ng);
+    F.heights.resize(ng);
+    parallel_for_each(
+        ng, 16,
+        [&](std::size_t g) {
+          // The field's grid blocks are the combined grid's around the same points.
+          const int cg = combined.find_grid_block(F.grid.gblock_key[g]);
+          SHELLMPM_CHECK(cg >= 0, "a shell field's grid block is on the combined grid");
+          F.heights[g] = heights_.block(static_cast<std::size_t>(cg));
+        },
+        serial);
     split_folds(F, gs, dt, serial);
     parallel_for_each(
         ng, 16,
         [&](std::size_t g) {
-          if (F.fold[g] < 0) return;
+          if (F.fold[g] < 0) return;  // no relative velocity there (after_g2p)
+          F.r[g].fill(Vec3::Zero());
           for (Node& d : F.nodes[g]) normalise(d);
           for (Node& d : F.folds[F.fold[g]].second) normalise(d);
         },
         serial);
     return;
   }
+  F.x0 = sh.x;
+  control_normals(F, sh);
+  F.grid.bin(sh.x, serial);
+  const std::size_t ng = F.grid.num_grid_blocks();
+  F.nodes.resize(ng);
+  F.r.resize(ng);
   parallel_for_each(
       ng, 16,
       [&](std::size_t g) {
@@ -235,6 +274,8 @@ void ShellFields::find_field_blocks(const SparseGrid& combined, bool serial) {
       [&](std::size_t g) {
         int* fb = fblock_.data() + g * K;
         for (std::size_t s = 0; s < K; ++s) {
+          // Heights only, no fold this step: the field was not binned.
+          if (heights_only_ && fields_[s].folds.empty()) continue;
           fb[s] = fields_[s].grid.find_grid_block(combined.gblock_key[g]);
           // Heights only: a node has two bodies only on the shell's fold blocks; elsewhere
           // the field has no full sums and the node keeps one velocity.
@@ -365,7 +406,7 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   const std::size_t K = fields_.size();
   friction_.resize(K);
   for (std::size_t s = 0; s < K; ++s) {
-    shell_p2g(fields_[s], shells[s], dt, serial);
+    shell_p2g(fields_[s], shells[s], combined, dt, serial);
     friction_[s] = shells[s].contact->params().friction;
   }
   const std::size_t ng = combined.num_grid_blocks();
@@ -429,6 +470,7 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
     ShellObject& sh = *gs.shell;
     const Real c_scale = Real(4) / static_cast<Real>(F.grid.dx());
     const bool folded = !F.folds.empty();
+    if (heights_only_ && !folded) continue;  // relative velocities exist on fold blocks only
     parallel_for_each(
         F.grid.num_particle_blocks(), 1,
         [&](std::size_t b) {
@@ -453,6 +495,8 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
               const bool second =
                   fi >= 0 && is_split(F.folds[fi], bn) &&
                   fold_height(F.normal[j], fx, n.i, n.j, n.k) >= F.folds[fi].cut[bn];
+              // Heights only: F.r is kept on fold blocks alone, zero elsewhere.
+              if (heights_only_ && fi < 0) return;
               const Vec3& rn = second ? F.folds[fi].r[bn] : F.r[nbr[o]][bn];
               if (rn.isZero()) return;
               any = true;

@@ -59,6 +59,9 @@ class ShellFields {
   void setup(const SparseGrid& grid, std::size_t num_shells, bool bulk, bool folds);
   bool active() const { return active_; }
 
+  /// Before the combined P2G: where one shell alone has fields (its folds' heights only),
+  /// its control-point normals and the heights for shell_p2g_block to sum; else null.
+  FoldHeights* begin_p2g(const SparseGrid& combined, const std::vector<GridShell>& shells);
   /// Right after the combined P2G (the combined grid holds mass and momentum): each
   /// shell's own P2G, and the relative velocities v_b^0 - v^0 of every body at the nodes
   /// two bodies share.
@@ -137,18 +140,15 @@ class ShellFields {
     return (n[0] * (Real(i) - fx[0]) + n[1] * (Real(j) - fx[1])) + n[2] * (Real(k) - fx[2]);
   }
   static bool is_split(const FoldBlock& fb, int bn) { return fb.split[bn] != 0; }
-  /// A node's mass and height range (Node's m, hmin, hmax) where heights_only_.
-  struct Heights {
-    Real m, hmin, hmax;
-  };
   struct Field {
     SparseGrid grid;  ///< binning of this shell's control points (no grid nodes)
     /// The shell, or its first class (heights_only_: set on fold blocks only).
     std::vector<std::array<Node, kBlockNodes>> nodes;
-    std::vector<std::array<Heights, kBlockNodes>> heights;  ///< heights_only_
-    std::vector<std::array<Vec3, kBlockNodes>> r;           ///< velocity relative to the node
-    std::vector<Vec3> x0;                                   ///< control points at p2g time
-    std::vector<Vec3> normal;                               ///< control-point unit normals
+    /// heights_only_, where the shell folds: the combined P2G's heights on this grid.
+    std::vector<std::array<NodeHeights, kBlockNodes>> heights;
+    std::vector<std::array<Vec3, kBlockNodes>> r;  ///< velocity relative to the node
+    std::vector<Vec3> x0;                          ///< control points at p2g time
+    std::vector<Vec3> normal;                      ///< control-point unit normals
     std::vector<int> fold;         ///< per grid block: index into folds, -1: no fold
     std::vector<FoldBlock> folds;  ///< grid blocks where the shell folds, in block order
     std::vector<int> touched;      ///< per particle block: index into the fold buffers
@@ -200,38 +200,18 @@ class ShellFields {
       add(d, w, r, k);
     }
   };
-  /// A control point's share of mass and height range only (heights_only_): the same bits
-  /// as PointShare's lanes 0, 14 and 15, without its other lanes.
-  struct HeightShare {
-    Real m, align;
-    Vec3 fx, n;
-    struct Row {
-      Real side;
-    };
-    HeightShare(const GridShell& gs, const Vec3& nj, const Vec3& f, std::uint32_t j, Real, Real,
-                bool)
-        : m(gs.shell->mass[j]), align(nj.dot(kAlign) >= 0 ? Real(1) : Real(-1)), fx(f), n(nj) {}
-    [[gnu::always_inline]] void row(int i, int j, Row& r) const {
-      r.side = n[0] * (Real(i) - fx[0]) + n[1] * (Real(j) - fx[1]);
-    }
-    [[gnu::always_inline]] void add(Heights& d, Real w, const Row& r, int k) const {
-      const Real side = r.side + n[2] * (Real(k) - fx[2]);
-      d.m += w * m;
-      if (w > 0) {
-        const Real h = align * side;  // fold_height
-        d.hmin = std::min(d.hmin, h);
-        d.hmax = std::max(d.hmax, h);
-      }
-    }
-  };
-  void shell_p2g(Field& F, const GridShell& gs, Real dt, bool serial);
+  /// F's control-point normals: the area-weighted normals of the control mesh's triangles.
+  static void control_normals(Field& F, const ShellObject& sh);
+  void shell_p2g(Field& F, const GridShell& gs, const SparseGrid& combined, Real dt, bool serial);
   /// Walks F's control points colour by colour (blocks of a colour touch disjoint nodes)
   /// and calls add(P, row, grid block, node, w, k) for each of their 27 stencil nodes, P
-  /// the point's Share (PointShare or HeightShare).
+  /// the point's PointShare.
   template <class Share, class AddFn>
   void scatter_shares(Field& F, const GridShell& gs, Real dt, bool heights, bool serial, AddFn add);
-  /// shell_p2g's sums of mass and heights only, into F.heights (heights_only_).
-  void shell_p2g_heights(Field& F, const GridShell& gs, Real dt, bool serial);
+  /// heights_only_: whether a node of the combined P2G's heights spreads (a fold).
+  bool any_spread(bool serial) const;
+  /// A node whose heights spread by kMinRange cells or more (shell_folds.cpp): two layers.
+  static bool spreads(const NodeHeights& d);
   /// Momentum to velocity, first moment to centroid offset.
   static void normalise(Node& d);
   /// Between the sums and their normalisation in shell_p2g: finds the nodes where F's
@@ -281,10 +261,12 @@ class ShellFields {
   bool active_ = false;
   bool folds_ = false;  ///< split_folds on
   /// One shell and no bulk material: a node holds two bodies only where the shell folds
-  /// (its two classes), so the field's P2G sums only mass and heights (Field::heights),
-  /// and full sums (Field::nodes) exist on fold blocks only, from the classes. Every other
-  /// node keeps one velocity, as it would with the full sums (one body there).
+  /// (its two classes), so only mass and heights are summed, in the combined P2G
+  /// (heights_), and full sums (Field::nodes) exist on fold blocks only, from the classes.
+  /// Every other node keeps one velocity, as it would with the full sums (one body
+  /// there). Where no node's heights spread, the field is not even binned (no blocks).
   bool heights_only_ = false;
+  FoldHeights heights_;
   std::vector<Field> fields_;
   std::vector<Real> friction_;  ///< per shell: c_F against bulk material
   // Per combined grid block: the fields' block indices (-1: absent), the bulk field's

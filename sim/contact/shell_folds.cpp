@@ -30,20 +30,24 @@ namespace {
 constexpr Real kMinRange = Real(1.0);
 }  // namespace
 
+bool ShellFields::spreads(const NodeHeights& d) {
+  return d.m > 0 && d.hmax - d.hmin >= kMinRange;
+}
+
 void ShellFields::mark_split_nodes(Field& F, bool heights_only) {
   const std::size_t ng = F.grid.num_grid_blocks();
   F.fold.assign(ng, -1);
   F.folds.clear();
   for (std::size_t g = 0; g < ng; ++g) {
     for (int n = 0; n < kBlockNodes; ++n) {
-      Heights d;
+      NodeHeights d;
       if (heights_only) {
         d = F.heights[g][n];
       } else {
         const Node& f = F.nodes[g][n];
         d = {f.m, f.hmin, f.hmax};
       }
-      if (!(d.m > 0) || !(d.hmax - d.hmin >= kMinRange)) continue;
+      if (!spreads(d)) continue;
       if (F.fold[g] < 0) {
         // Heights only: the full sums of a fold block come from its classes alone.
         if (heights_only) Node::clear(F.nodes[g].data(), kBlockNodes);

@@ -65,17 +65,18 @@ void prescribe_pins(ShellObject& sh, double t, double dt, std::vector<std::uint8
 }
 
 void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
-                     const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf) {
+                     const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf,
+                     FoldHeights* heights) {
   const std::uint32_t* order = grid.order().data();
   switch (simd_level()) {
     case SimdLevel::Avx512:
-      return shell_blocks::p2g_avx512(grid, order, table, shells, dt, b, buf);
+      return shell_blocks::p2g_avx512(grid, order, table, shells, dt, b, buf, heights);
     case SimdLevel::Avx2:
-      return shell_blocks::p2g_avx2(grid, order, table, shells, dt, b, buf);
+      return shell_blocks::p2g_avx2(grid, order, table, shells, dt, b, buf, heights);
     case SimdLevel::Sse:
       break;
   }
-  shell_blocks::p2g(grid, order, table, shells, dt, b, buf);
+  shell_blocks::p2g(grid, order, table, shells, dt, b, buf, heights);
 }
 
 void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,
@@ -97,12 +98,21 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
   const std::uint32_t nc = table.num_control_points();
   const auto ns = static_cast<std::uint32_t>(table.size());
   const std::uint32_t* order = grid.order().data();
-  // Colour by colour (blocks of a colour touch disjoint nodes): each block with contact
-  // particles reads its nodes' masses and adds its velocity increments straight into the
-  // grid.
+  // The sites that push (dpsi/da3E != 0; separated sites without shear have none), one
+  // byte per table entry from nc on, read in one pass over each shell's G3.
+  std::vector<std::uint8_t> pushing(ns - nc);
+  for (std::uint32_t i = 0, s = 0; s < shells.size(); ++s) {
+    const std::vector<Vec3>& G3 = shells[s].contact->G3;
+    for (std::size_t p = 0; p < G3.size(); ++p, ++i) pushing[i] = G3[p].squaredNorm() != 0;
+  }
+  const std::uint8_t* push = pushing.data() - nc;  // push[g] for table entries g >= nc
+  // Colour by colour (blocks of a colour touch disjoint nodes): each block with pushing
+  // contact particles reads its nodes' masses and adds its velocity increments straight
+  // into the grid.
   grid.for_each_block_by_colour(
       [&](std::size_t b) {
-        const auto [lo, hi] = shell_blocks::slice(grid, order, b, nc, ns);
+        auto [lo, hi] = shell_blocks::slice(grid, order, b, nc, ns);
+        while (lo < hi && !push[order[lo]]) ++lo;
         if (lo == hi) return;
         GridNode pad[kPadNodes], inc[kPadNodes];
         std::memset(static_cast<void*>(inc), 0, sizeof inc);
@@ -110,16 +120,16 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
         bool added = false;
         switch (simd_level()) {
           case SimdLevel::Avx512:
-            added = shell_blocks::normal_forces_avx512(grid, order, table, shells, dt, b, lo, hi,
-                                                       pad, inc);
+            added = shell_blocks::normal_forces_avx512(grid, order, table, shells, push, dt, b, lo,
+                                                       hi, pad, inc);
             break;
           case SimdLevel::Avx2:
-            added = shell_blocks::normal_forces_avx2(grid, order, table, shells, dt, b, lo, hi, pad,
-                                                     inc);
+            added = shell_blocks::normal_forces_avx2(grid, order, table, shells, push, dt, b, lo,
+                                                     hi, pad, inc);
             break;
           case SimdLevel::Sse:
-            added =
-                shell_blocks::normal_forces(grid, order, table, shells, dt, b, lo, hi, pad, inc);
+            added = shell_blocks::normal_forces(grid, order, table, shells, push, dt, b, lo, hi,
+                                                pad, inc);
             break;
         }
         if (added) grid.add_pad_to_grid(b, inc);

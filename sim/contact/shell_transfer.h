@@ -18,6 +18,7 @@
 #pragma once
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "sim/contact/shell_contact.h"
@@ -61,10 +62,42 @@ class ShellPointTable {
 /// records them in `held` (released pins hold nothing).
 void prescribe_pins(ShellObject& sh, double t, double dt, std::vector<std::uint8_t>& held);
 
+/// A grid node's fold heights (shell_folds.cpp): the mass of one shell's control points
+/// there and the least and greatest height of the node over their tangent planes, in
+/// cells, along their normals turned to a fixed direction.
+struct NodeHeights {
+  Real m, hmin, hmax;
+};
+/// No mass, empty height range.
+constexpr NodeHeights kNoHeights{Real(0), std::numeric_limits<Real>::max(),
+                                 std::numeric_limits<Real>::lowest()};
+
+/// The fold heights of a lone shell's control points, summed in the combined P2G
+/// (ShellFields::begin_p2g): per combined grid block, a node's sum of w m and range of
+/// fold_height over the points with w > 0. A block's nodes are set (from kNoHeights)
+/// when a point first reaches one of them: where ready is 0 they are all kNoHeights.
+struct FoldHeights {
+  const Vec3* normal = nullptr;  ///< per control point: unit normal
+  Vec3 align;                    ///< normals are turned to this direction's side
+  std::vector<std::array<NodeHeights, kBlockNodes>> blocks;
+  std::vector<std::uint8_t> ready;
+  const std::array<NodeHeights, kBlockNodes>& block(std::size_t g) const {
+    static const std::array<NodeHeights, kBlockNodes> none = [] {
+      std::array<NodeHeights, kBlockNodes> a;
+      a.fill(kNoHeights);
+      return a;
+    }();
+    return ready[g] ? blocks[g] : none;
+  }
+};
+
 /// P2G of the control points binned in particle block b into its buffer: mass, APIC
-/// momentum and dt * force, with weights w_ij.
+/// momentum and dt * force, with weights w_ij; where `heights` is not null, also their
+/// fold heights into heights->blocks (call colour by colour: blocks of a colour touch
+/// disjoint nodes).
 void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
-                     const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf);
+                     const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf,
+                     FoldHeights* heights = nullptr);
 
 /// G2P for block b: control points get v, C and x += dt v (held components keep their
 /// prescribed velocity); contact particles a3E <- (I + dt grad~v) a3E.

@@ -176,15 +176,6 @@ class SparseGrid {
   void add_pad_to_grid(std::size_t b, const GridNode* pad);
   /// Copies the grid nodes that particle block b's padded region overlaps into pad.
   void copy_grid_to_pad(std::size_t b, GridNode* pad) const;
-
- private:
-  /// d += s.
-  static void add_node(GridNode& d, const GridNode& s) {
-    d.m += s.m;
-    d.v[0] += s.v[0];
-    d.v[1] += s.v[1];
-    d.v[2] += s.v[2];
-  }
   /// Calls f(grid block, node in it, node of the padded region) for every node of particle
   /// block b's padded region.
   template <class F>
@@ -197,6 +188,15 @@ class SparseGrid {
         for (int j = 0; j < iy1; ++j)
           for (int k = 0; k < iz1; ++k) f(g, block_node(i, j, k), pad_node(i + ox, j + oy, k + oz));
     }
+  }
+
+ private:
+  /// d += s.
+  static void add_node(GridNode& d, const GridNode& s) {
+    d.m += s.m;
+    d.v[0] += s.v[0];
+    d.v[1] += s.v[1];
+    d.v[2] += s.v[2];
   }
   void bin_points(const std::vector<Vec3>* first, const std::vector<Vec3>& x, bool serial,
                   bool with_order);

@@ -11,9 +11,12 @@ bool P2gStage::needed(const Scene& s) {
 void P2gStage::run(StepContext& c) {
   TransferParams tp = c.transfer_params();
   const Real dt = tp.dt;
+  // A lone folding shell's heights are summed with its control points' P2G.
+  FoldHeights* heights =
+      c.shell_fields.active() ? c.shell_fields.begin_p2g(c.grid, c.grid_shells) : nullptr;
   if (!c.grid_shells.empty())
-    tp.others = [&c, dt](std::size_t b, GridNode* buf) {
-      shell_p2g_block(c.grid, c.shell_table, c.grid_shells, dt, b, buf);
+    tp.others = [&c, dt, heights](std::size_t b, GridNode* buf) {
+      shell_p2g_block(c.grid, c.shell_table, c.grid_shells, dt, b, buf, heights);
     };
   particles_to_grid(c.particles, c.grid, tp);
   if (c.shell_fields.active())
