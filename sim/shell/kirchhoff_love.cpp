@@ -98,8 +98,10 @@ KirchhoffLoveShellT<T>::KirchhoffLoveShellT(std::vector<BasisPoint> points,
     reset_plastic_state();
   }
   build_gather_map();
-  if constexpr (std::is_same_v<T, float>)
+  if constexpr (std::is_same_v<T, float>) {
     patches_ = kl::build_patches(begin_, ctrl_, coef_, num_ctrl_);
+    if (!patches_.empty()) kl::lay_out_lanes(patches_, B_, area_, num_layers_);
+  }
 }
 
 template <class T>
@@ -326,9 +328,12 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
   // Per chunk: total and membrane energy.
   // (On patches, chunks of kPointGrain points' worth of patches.)
   const std::size_t n = patched ? patches_.num_patches() : nq;
-  const std::size_t grain = patched ? kPointGrain / std::size_t(patches_.points) : kPointGrain;
+  // (Patch chunks start at multiples of the lane blocks: kl_patches.h, B_lanes.)
+  constexpr std::size_t kLB = kl::Patches::kLaneBlock;
+  const std::size_t grain =
+      patched ? std::max(kLB, kPointGrain / std::size_t(patches_.points) / kLB * kLB) : kPointGrain;
   const std::vector<std::array<double, 2>> parts =
-      chunk_parts(n, std::max<std::size_t>(grain, 1), serial, std::array<double, 2>{0.0, 0.0},
+      chunk_parts(n, grain, serial, std::array<double, 2>{0.0, 0.0},
                   [&](std::size_t b, std::size_t e, std::array<double, 2>& part) {
                     double et = 0.0, em = 0.0;
                     if constexpr (std::is_same_v<T, float>) {

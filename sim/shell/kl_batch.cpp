@@ -65,9 +65,9 @@ void KirchhoffLoveShellT<float>::eval_patch_range(std::size_t i0, std::size_t n,
   const kl::BatchData d = batch_data();
   const kl::Patches& pt = patches_;
   const kl::PatchData p{
-      pt.points,      pt.order.data(), pt.pattern.data(),      pt.begin.data(),
-      pt.ctrl.data(), pt.slot.data(),  pt.pattern_size.data(), pt.pattern_coef.data(),
-      pt.coefs.data()};
+      pt.points,       pt.order.data(),   pt.pattern.data(),      pt.begin.data(),
+      pt.ctrl.data(),  pt.slot.data(),    pt.pattern_size.data(), pt.pattern_coef.data(),
+      pt.coefs.data(), pt.B_lanes.data(), pt.area_lanes.data()};
   const SimdLevel level = simd_level();
   const kl::PatchFn run = level == SimdLevel::Avx512 ? kl::eval_patches_avx512
                           : level == SimdLevel::Avx2 ? kl::eval_patches_avx2

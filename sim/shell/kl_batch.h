@@ -49,6 +49,8 @@ struct PatchData {
   const std::uint32_t* pattern_size;
   const std::uint32_t* pattern_coef;
   const float* coefs;
+  const float* B_lanes;     ///< Patches::B_lanes
+  const float* area_lanes;  ///< Patches::area_lanes
 };
 
 /// Patches p.order[i0 .. i0 + n - 1]: energy[(i - i0) P + k] the energy of point k of the

@@ -19,6 +19,7 @@
 // the eigenvalues of C (s_1^2 = tr/2 + h, s_2^2 = det / s_1^2) instead of exp(L +- D)/4.
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 
 #include "sim/shell/kl_batch.h"
 #include "sim/shell/kl_lanes.h"
@@ -135,11 +136,26 @@ template <class F>
     }
 }
 
+/// W floats from p (any alignment).
+template <class F>
+[[gnu::always_inline]] inline F load_lanes(const float* p) {
+  F v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
 /// One point per lane (lane j: point qs[j]) from its a_1, a_2, a_11, a_12, a_22 (av):
-/// the energy, and where `adjoints` the adjoints of av in G (eval_kinematics).
+/// the energy, and where `adjoints` the adjoints of av in G (eval_kinematics). The points'
+/// B and area come from the per-point arrays, or where `lanes` is not null already in
+/// lanes: lanes->B[(4 l + e) Patches::kLaneBlock] and lanes->area (Patches::B_lanes).
+struct RestLanes {
+  const float* B;
+  const float* area;
+};
 template <class F>
 [[gnu::always_inline]] inline F point_lanes(const BatchData& d, const std::size_t* qs,
-                                            const V3<F> (&av)[5], bool adjoints, V3<F> (&G)[5]) {
+                                            const RestLanes* lanes, const V3<F> (&av)[5],
+                                            bool adjoints, V3<F> (&G)[5]) {
   constexpr int W = lanes::kLanes<F>;
   const int nl = d.num_layers;
   const V3<F> a1 = av[0], a2 = av[1], a11 = av[2], a12 = av[3], a22 = av[4];
@@ -152,7 +168,10 @@ template <class F>
   const V3<F> v1 = t1 - dot(a3, t1) * a3;
   const V3<F> v2 = t2 - dot(a3, t2) * a3;
   F area;
-  for (int j = 0; j < W; ++j) area[j] = d.area[qs[j]];
+  if (lanes)
+    area = load_lanes<F>(lanes->area);
+  else
+    for (int j = 0; j < W; ++j) area[j] = d.area[qs[j]];
   const V3<F> zero{splat<F>(0.0f), splat<F>(0.0f), splat<F>(0.0f)};
   V3<F> Ga1 = zero, Ga2 = zero, Gv1 = zero, Gv2 = zero;
   F energy = splat<F>(0.0f);
@@ -162,8 +181,13 @@ template <class F>
     const F m11 = dot(g1, g1), m12 = dot(g1, g2), m22 = dot(g2, g2);
     __m128 rows[W];
     F Bp[4];
-    for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.B[4 * (qs[j] * nl + l)]);
-    transpose_in<F>(rows, Bp);
+    if (lanes) {
+      for (int e = 0; e < 4; ++e)
+        Bp[e] = load_lanes<F>(lanes->B + std::size_t(4 * l + e) * Patches::kLaneBlock);
+    } else {
+      for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.B[4 * (qs[j] * nl + l)]);
+      transpose_in<F>(rows, Bp);
+    }
     if (d.fp_inv) {
       F Fi[4];
       for (int j = 0; j < W; ++j) rows[j] = _mm_loadu_ps(&d.fp_inv[4 * (qs[j] * nl + l)]);
@@ -253,7 +277,7 @@ template <int W>
       av[i] = V3<F>{t[0], t[1], t[2]};
     }
     V3<F> out[5];
-    const F energy = point_lanes<F>(d, qs, av, fe != nullptr, out);
+    const F energy = point_lanes<F>(d, qs, nullptr, av, fe != nullptr, out);
     for (int j = 0; j < cnt; ++j) energy_out[b - q0 + std::size_t(j)] = energy[j];
     if (a12_out) store_a12<F>(av, cnt, 6, a12_out + 6 * (b - q0));
     if (!fe) continue;
@@ -276,7 +300,8 @@ template <int W>
 }
 
 /// Patch path (sim/shell/kl_patches.h): patches p.order[i0 .. i0 + n - 1], one per lane,
-/// W of one pattern at a time; energy_out[(i - i0) P + k] is point k of the patch at
+/// W of one pattern and one lane block at a time (their B and area loaded from the lane
+/// layout, Patches::B_lanes); energy_out[(i - i0) P + k] is point k of the patch at
 /// position i. A point's a_alpha, a_alphabeta are summed over its control points in the
 /// per-point path's order with the same coefficients, so they and the point's energy and
 /// adjoints are the same bits on both paths; a share sums the patch's points in order.
@@ -289,10 +314,14 @@ template <int W>
   for (std::size_t i = i0; i < i0 + n;) {
     const std::uint32_t pat = p.pattern[p.order[i]];
     int cnt = 1;
-    while (cnt < W && i + std::size_t(cnt) < i0 + n && p.pattern[p.order[i + cnt]] == pat) ++cnt;
+    // A register's patches share a pattern and a lane block (Patches::B_lanes).
+    while (cnt < W && i + std::size_t(cnt) < i0 + n && p.pattern[p.order[i + cnt]] == pat &&
+           (i + std::size_t(cnt)) % Patches::kLaneBlock != 0)
+      ++cnt;
     // Lane j: patch order[i + j]; lanes past cnt repeat the last (results unused).
     std::uint32_t g[W];
     for (int j = 0; j < W; ++j) g[j] = p.order[i + std::size_t(std::min(j, cnt - 1))];
+    const std::size_t blk = i / Patches::kLaneBlock, lane0 = i % Patches::kLaneBlock;
     const int m = static_cast<int>(p.pattern_size[pat]);
     const float* const C = p.coefs + p.pattern_coef[pat];  // [k][c][5]
     // Control positions, one patch per lane, relative to the first.
@@ -315,7 +344,13 @@ template <int W>
       }
       std::size_t qs[W];
       for (int j = 0; j < W; ++j) qs[j] = std::size_t(g[j]) * P + k;
-      const F energy = point_lanes<F>(d, qs, av, fe != nullptr, G[k]);
+      // The rest data in lanes: lanes past cnt read other patches' (finite; their results
+      // are unused).
+      const std::size_t row = blk * std::size_t(P) + std::size_t(k);
+      const RestLanes lanes{
+          p.B_lanes + row * std::size_t(4 * d.num_layers) * Patches::kLaneBlock + lane0,
+          p.area_lanes + row * Patches::kLaneBlock + lane0};
+      const F energy = point_lanes<F>(d, qs, &lanes, av, fe != nullptr, G[k]);
       const std::size_t o = (i - i0) * P + k;
       for (int j = 0; j < cnt; ++j) energy_out[o + std::size_t(j) * P] = energy[j];
       if (a12_out) store_a12<F>(av, cnt, 6 * std::size_t(P), a12_out + 6 * o);

@@ -81,4 +81,25 @@ Patches build_patches(const std::vector<std::size_t>& begin, const std::vector<i
   return p;
 }
 
+void lay_out_lanes(Patches& p, const std::vector<float>& B, const std::vector<float>& area,
+                   int num_layers) {
+  const std::size_t np = p.num_patches(), P = std::size_t(p.points), L = std::size_t(num_layers);
+  constexpr std::size_t kB = Patches::kLaneBlock;
+  const std::size_t blocks = (np + kB - 1) / kB;
+  // (The padding: B = (1, 1, 1, 1) and area 1, finite for the lanes that read it.)
+  p.B_lanes.assign(blocks * P * L * 4 * kB + kB, 1.0f);
+  p.area_lanes.assign(blocks * P * kB + kB, 1.0f);
+  for (std::size_t c = 0; c < blocks; ++c)
+    for (std::size_t o = 0; o < kB; ++o) {
+      const std::size_t g = p.order[std::min(c * kB + o, np - 1)];
+      for (std::size_t k = 0; k < P; ++k) {
+        const std::size_t q = g * P + k;
+        p.area_lanes[(c * P + k) * kB + o] = area[q];
+        for (std::size_t l = 0; l < L; ++l)
+          for (std::size_t e = 0; e < 4; ++e)
+            p.B_lanes[(((c * P + k) * L + l) * 4 + e) * kB + o] = B[4 * (q * L + l) + e];
+      }
+    }
+}
+
 }  // namespace shellmpm::kl

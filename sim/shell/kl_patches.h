@@ -31,6 +31,14 @@ struct Patches {
   std::vector<std::uint32_t> pattern_size;  ///< per pattern: control points m
   std::vector<std::uint32_t> pattern_coef;  ///< per pattern: offset of its [k][c][5] table
   std::vector<float> coefs;                 ///< the tables: N1, N2, N11, N12, N22
+  /// The points' rest data in lanes (lay_out_lanes): for each block of kLaneBlock
+  /// positions of `order`, each point k and layer l of a patch, the four entries of B and
+  /// then the area, kLaneBlock patches side by side, so that a register of the patches at
+  /// positions i .. i + W - 1 of one block loads them without a transpose. Padded by
+  /// kLaneBlock floats (a register that starts inside a block may read past it).
+  static constexpr int kLaneBlock = 16;
+  std::vector<float> B_lanes;     ///< [block][k][l][4][kLaneBlock]
+  std::vector<float> area_lanes;  ///< [block][k][kLaneBlock]
 
   bool empty() const { return points == 0; }
   std::size_t num_patches() const { return pattern.size(); }
@@ -43,5 +51,10 @@ struct Patches {
 /// control list (at most kMaxCtrl).
 Patches build_patches(const std::vector<std::size_t>& begin, const std::vector<int>& ctrl,
                       const std::vector<float>& coef, std::size_t num_ctrl);
+
+/// Fills p.B_lanes and p.area_lanes from the per-point B (4 per (point, layer)) and area
+/// of num_layers layers (positions past the last patch repeat it).
+void lay_out_lanes(Patches& p, const std::vector<float>& B, const std::vector<float>& area,
+                   int num_layers);
 
 }  // namespace shellmpm::kl

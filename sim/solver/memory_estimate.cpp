@@ -238,10 +238,12 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
   // Per entry its control point and gather slot (4 + 4), coefficients and value (6 R).
   // In float, the faces' patches (sim/shell/kl_patches.h): per (face, control point) its
   // control point and slot, per face its start, pattern and place in the order, per
-  // control point its gather start (the patterns' tables are a few kB).
+  // control point its gather start (the patterns' tables are a few kB), and a copy of the
+  // points' B and area in lanes.
   const bool patched = sizeof(Real) == 4;
   const double face_entries = T * S;
-  const double patches = patched ? face_entries * 8 + T * 12 + 8 * V : 0;
+  const double patches =
+      patched ? face_entries * 8 + T * 12 + 8 * V + qp * (4 * R * layers + R) : 0;
   const double kl = entries * (8 + 6 * R) + qp * (8 + R + 4 * R * layers + 4 * R) +
                     (m.yield_stress > 0 ? qp * 4 * R * layers : 0) + 8 * V + patches;
   const double limit = limit_mesh_bytes(Vout, Tout, S, c.has_uvs);
