@@ -24,6 +24,9 @@ namespace shellmpm::shell_blocks {
 
 #define SHELLMPM_BLOCKS_INLINE [[gnu::always_inline]] inline
 
+/// Points ahead of the one a block's loop is at whose data it prefetches.
+constexpr std::uint32_t kAhead = 8;
+
 /// Slice of block b's order entries holding shell points of one kind: [lo, hi). (The
 /// functions here take grid.order() as `order`: its check would make the per-ISA objects
 /// define the exception's inline members.)
@@ -73,7 +76,6 @@ SHELLMPM_BLOCKS_INLINE void for_each_site_dots(const SparseGrid& grid, const std
                                                const GridNode* pad, bool weighted, Skip skip, F f) {
   const Real dx = static_cast<Real>(grid.dx());
   const bool forces = !weighted;
-  constexpr std::uint32_t kAhead = 8;
   SiteBatch batch;
   auto flush = [&]() {
     site_dots::dots_lanes<site_dots::Lanes>(batch.in, batch.n, dx, weighted, batch.dots, batch.any);
@@ -169,6 +171,21 @@ SHELLMPM_BLOCKS_INLINE void merge_heights(const SparseGrid& grid, std::size_t b,
   });
 }
 
+/// Prefetches what the control points' P2G (with heights where not null: the normal) and
+/// G2P read of control point g.
+SHELLMPM_BLOCKS_INLINE void prefetch_control_point(const ShellPointTable& table,
+                                                   const std::vector<GridShell>& shells,
+                                                   std::uint32_t g, const FoldHeights* heights) {
+  const GridShell& gs = shells[table.shell(g)];
+  const std::uint32_t j = table.local(g);
+  __builtin_prefetch(&gs.shell->x[j]);
+  __builtin_prefetch(&gs.shell->v[j]);
+  __builtin_prefetch(&gs.contact->C[j]);
+  __builtin_prefetch(&gs.force[j]);
+  __builtin_prefetch(&gs.shell->mass[j]);
+  if (heights) __builtin_prefetch(&heights->normal[j]);
+}
+
 /// shell_p2g_block's loop.
 SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* order,
                                 const ShellPointTable& table, const std::vector<GridShell>& shells,
@@ -183,6 +200,7 @@ SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* ord
               HeightsPadNode{Real(0), std::numeric_limits<Real>::max(),
                              std::numeric_limits<Real>::max(), Real(0)});
   for (std::uint32_t s = lo; s < hi; ++s) {
+    if (s + kAhead < hi) prefetch_control_point(table, shells, order[s + kAhead], heights);
     const std::uint32_t g = order[s];
     const GridShell& gs = shells[table.shell(g)];
     const std::uint32_t j = table.local(g);
@@ -209,6 +227,8 @@ SHELLMPM_BLOCKS_INLINE void g2p(const SparseGrid& grid, const std::uint32_t* ord
   // The block's control points come first in its slice (the order ascends within a block).
   std::uint32_t s = lo;
   for (; s < hi && order[s] < nc; ++s) {
+    if (s + kAhead < hi && order[s + kAhead] < nc)
+      prefetch_control_point(table, shells, order[s + kAhead], nullptr);
     const std::uint32_t g = order[s];
     GridShell& gs = shells[table.shell(g)];
     const std::uint32_t j = table.local(g);
