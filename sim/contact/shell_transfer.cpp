@@ -26,6 +26,7 @@ void ShellPointTable::build(const std::vector<GridShell>& shells) {
       shell_.push_back(static_cast<std::uint16_t>(s));
       local_.push_back(static_cast<std::uint32_t>(p));
     }
+  single_ = shells.size() == 1;
 }
 
 void ShellPointTable::positions(const std::vector<GridShell>& shells,

@@ -49,13 +49,17 @@ class ShellPointTable {
   /// Velocities in binning order: the control points', zero for contact particles (they
   /// move with them).
   void velocities(const std::vector<GridShell>& shells, std::vector<Vec3>& out) const;
-  std::uint16_t shell(std::uint32_t i) const { return shell_[i]; }
-  std::uint32_t local(std::uint32_t i) const { return local_[i]; }
+  /// Shell and index in it of point i (one shell: by arithmetic, no table read).
+  std::uint16_t shell(std::uint32_t i) const { return single_ ? 0 : shell_[i]; }
+  std::uint32_t local(std::uint32_t i) const {
+    return single_ ? (i < num_ctrl_ ? i : i - num_ctrl_) : local_[i];
+  }
 
  private:
   std::vector<std::uint16_t> shell_;
   std::vector<std::uint32_t> local_;
   std::uint32_t num_ctrl_ = 0;
+  bool single_ = false;  ///< one shell
 };
 
 /// Sets the velocity of pinned components to the pin's motion over [t, t + dt] and
