@@ -13,12 +13,13 @@
 #include "io/atomic_file.h"
 #include "io/checksum.h"
 #include "io/shot_runner.h"
+#include "sim/contact/friction_return_map.h"
 #include "sim/solver/solver.h"
 
 namespace shellmpm {
 namespace {
 
-constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '4'};
+constexpr char kMagic[8] = {'S', 'H', 'M', 'P', 'M', 'C', 'K', '5'};
 constexpr char kEndMagic[8] = {'S', 'H', 'M', 'P', 'M', 'E', 'N', 'D'};
 constexpr std::size_t kHeaderBytes = 8 + 4 + 8;  // magic, sizeof(Real), payload size
 constexpr std::size_t kTrailerBytes = 4 + 8;     // CRC-32, end magic
@@ -78,6 +79,7 @@ void put_payload(Sink& s, const Checkpoint& c) {
     put_vec(s, sh.plastic);
     put_vec(s, sh.C);
     put_vec(s, sh.a3e);
+    put_vec(s, sh.contact_state);
   }
 }
 
@@ -204,6 +206,10 @@ void parse_payload(Cursor& in, Checkpoint& c) {
     in.get_vec(sh.plastic, name + " plastic state");
     in.get_vec(sh.C, name + " APIC matrices");
     in.get_vec(sh.a3e, name + " contact normals");
+    in.get_vec(sh.contact_state, name + " contact states", sh.a3e.size());
+    for (const std::uint8_t st : sh.contact_state)
+      if (st > static_cast<std::uint8_t>(ContactState::Sliding))
+        in.fail(name + " has a contact state out of range");
     require_finite(in, sh.x, name + " position");
     require_finite(in, sh.v, name + " velocity");
     require_finite(in, sh.plastic, name + " plastic state");
@@ -292,6 +298,7 @@ void save_shells(const Solver& solver, Checkpoint& c) {
     if (const ShellContact* ct = solver.contact(c.shells.size())) {
       st.C = ct->C;
       st.a3e = ct->a3e;
+      st.contact_state = ct->state;
     }
     c.shells.push_back(std::move(st));
   }
@@ -339,6 +346,7 @@ void restore_checkpoint(Solver& solver, Checkpoint&& c, const std::string& path)
     if (ShellContact* ct = solver.contact(i)) {
       ct->C = c.shells[i].C;
       ct->a3e = c.shells[i].a3e;
+      ct->state = c.shells[i].contact_state;
     }
   }
   solver.set_shell_plastic_work(c.shell_plastic_work);

@@ -1,8 +1,9 @@
 // Checkpoints: the full solver state at the end of a frame, so `--resume` continues a
 // killed run and produces output bit-identical to an uninterrupted one.
 //
-// File layout (little-endian), format 4 (particle kinds: a material and rest volume each):
-//   header   "SHMPMCK4", u32 sizeof(Real), u64 payload size
+// File layout (little-endian), format 5 (particle kinds: a material and rest volume each;
+// the contact particles' return-mapping states):
+//   header   "SHMPMCK5", u32 sizeof(Real), u64 payload size
 //   payload  scene fingerprint, frame, time, particles, statistics, shells (checkpoint.cpp)
 //   trailer  u32 CRC-32 of header and payload (io/checksum.h), "SHMPMEND"
 // A damaged file (any byte changed, truncated, extended) fails the length or checksum
@@ -31,6 +32,7 @@ struct Checkpoint {
     std::vector<Real> plastic;
     std::vector<Mat3> C;    ///< APIC matrices of the control points (contact on; else empty)
     std::vector<Vec3> a3e;  ///< contact particles' normal columns (contact on; else empty)
+    std::vector<std::uint8_t> contact_state;  ///< their ContactState after the last step
   };
   std::vector<ShellState> shells;
   double shell_plastic_work = 0;

@@ -106,16 +106,18 @@ void ShellContact::position_and_tangents(const Vec3* ctrl, std::size_t p, Vec3& 
   a2 = Vec3(t2[0], t2[1], t2[2]);
 }
 
+Vec3 ShellContact::position(const Vec3* ctrl, std::size_t p) const {
+  const Vec3 ref = ctrl[idx[off[p]]];
+  Vec3 d = Vec3::Zero();
+  for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) d += N[k] * (ctrl[idx[k]] - ref);
+  return ref + d;
+}
+
 void ShellContact::update_positions(const Vec3* ctrl, bool serial) {
   parallel_for(
       num_sites(), kGrain,
       [&](std::size_t b, std::size_t e) {
-        for (std::size_t p = b; p < e; ++p) {
-          const Vec3 ref = ctrl[idx[off[p]]];
-          Vec3 d = Vec3::Zero();
-          for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) d += N[k] * (ctrl[idx[k]] - ref);
-          x[p] = ref + d;
-        }
+        for (std::size_t p = b; p < e; ++p) x[p] = position(ctrl, p);
       },
       serial);
 }
@@ -144,20 +146,24 @@ double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
   const bool kept = tangents_ctrl_.size() == nc &&
                     std::memcmp(static_cast<const void*>(tangents_ctrl_.data()),
                                 static_cast<const void*>(ctrl), nc * sizeof(Vec3)) == 0;
+  const auto separated = static_cast<std::uint8_t>(ContactState::Separated);
   const double e =
       ordered_reduce_chunks(num_sites(), kGrain, serial, 0.0, [&](std::size_t b, std::size_t en) {
         double acc = 0.0;
-        for (std::size_t p0 = b; p0 < en; p0 += kFrameLanes) {
-          const int n = static_cast<int>(std::min<std::size_t>(kFrameLanes, en - p0));
+        // Sites the last return mapping left separated have no force: their a3E is the unit
+        // normal of these tangents (s = (0, 0, 1) up to round-off, psi = 0). The others
+        // kFrameLanes at a time, in site order.
+        std::size_t sites[kFrameLanes];
+        int n = 0;
+        const auto flush = [&]() {
           GradientLanes gl;
           for (int j = 0; j < kFrameLanes; ++j) {
-            const int from = j < n ? j : 0;  // lanes past n repeat site p0
-            const std::size_t p = p0 + static_cast<std::size_t>(from);
+            const std::size_t p = sites[j < n ? j : 0];  // lanes past n repeat the first
             Vec3 a1, a2;
             if (kept) {
               a1 = a1_[p];
               a2 = a2_[p];
-            } else if (j == from) {
+            } else if (j < n) {
               position_and_tangents(ctrl, p, x[p], a1, a2);
             } else {
               a1 = Vec3(gl.a1[0][0], gl.a1[1][0], gl.a1[2][0]);
@@ -171,14 +177,25 @@ double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
           }
           contact_lanes::gradients(gl, params_);
           for (int j = 0; j < n; ++j) {
-            const std::size_t p = p0 + static_cast<std::size_t>(j);
+            const std::size_t p = sites[j];
             const Real V = volume[p];
             G1_[p] = V * Vec3(gl.g[0][0][j], gl.g[0][1][j], gl.g[0][2][j]);
             G2_[p] = V * Vec3(gl.g[1][0][j], gl.g[1][1][j], gl.g[1][2][j]);
             G3[p] = Vec3(gl.g[2][0][j], gl.g[2][1][j], gl.g[2][2][j]);
             acc += static_cast<double>(V * gl.psi[j]);
           }
+          n = 0;
+        };
+        for (std::size_t p = b; p < en; ++p) {
+          if (state[p] == separated) {
+            if (!kept) x[p] = position(ctrl, p);
+            G1_[p] = G2_[p] = G3[p] = Vec3::Zero();
+            continue;
+          }
+          sites[n++] = p;
+          if (n == kFrameLanes) flush();
         }
+        if (n) flush();
         return acc;
       });
   parallel_for(

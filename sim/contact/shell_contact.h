@@ -40,7 +40,9 @@ class ShellContact {
   /// Contact energy sum V psi [J]. Updates the site positions x (update_positions), stores
   /// dpsi/da3E per site in `G3` (for the grid's normal force) and adds the tangential part, f_j =
   /// -sum_p V_p sum_beta dN_j/dxi_beta dpsi/da_beta, to the control-point forces f (deterministic
-  /// gather per point).
+  /// gather per point). Sites whose `state` is Separated count zero: the return mapping
+  /// that set it made their a3E the unit normal of the control points it saw, which the
+  /// explicit step passes here unmoved (s = (0, 0, 1) up to round-off).
   double forces(const Vec3* ctrl, Vec3* f, bool serial);
   /// Energy only [J].
   double energy(const Vec3* ctrl, bool serial) const;
@@ -85,6 +87,8 @@ class ShellContact {
   /// The return mapping of site p with its frame in lane j of fl.
   ReturnMapSums return_map_site(std::size_t p, const FrameLanes& fl, int j);
 
+  /// Site p's position (update_positions).
+  Vec3 position(const Vec3* ctrl, std::size_t p) const;
   /// Site p's position and tangents in one pass over its stencil (the sums of
   /// update_positions and tangents).
   void position_and_tangents(const Vec3* ctrl, std::size_t p, Vec3& xp, Vec3& a1, Vec3& a2) const;

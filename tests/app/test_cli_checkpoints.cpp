@@ -104,7 +104,8 @@ std::vector<Section> sections(const std::string& b) {
                                                         {"shell velocities", 3 * real},
                                                         {"shell plastic state", real},
                                                         {"shell APIC matrices", 9 * real},
-                                                        {"shell contact normals", 3 * real}})
+                                                        {"shell contact normals", 3 * real},
+                                                        {"shell contact states", 1}})
     array(name, elem);
   s.push_back({"checksum", at + 1});
   s.push_back({"end marker", at + 4 + 6});

@@ -50,6 +50,7 @@ Checkpoint small_checkpoint() {
   }
   sh.plastic = {1, 0, 0, 1, 1, 0, 0, 1};
   sh.a3e = {Vec3(0, 1, 0), Vec3(0, 0.9f, 0.1f)};
+  sh.contact_state = {0, 2};  // separated, sliding
   c.shells.push_back(sh);
   c.shell_plastic_work = 0.5;
   c.friction_work = 0.25;
@@ -143,6 +144,7 @@ TEST_CASE("a checkpoint reads back bit for bit", "[checkpoint]") {
   CHECK(same_bits(b.shells[0].plastic, a.shells[0].plastic));
   CHECK(same_bits(b.shells[0].C, a.shells[0].C));
   CHECK(same_bits(b.shells[0].a3e, a.shells[0].a3e));
+  CHECK(b.shells[0].contact_state == a.shells[0].contact_state);
   CHECK(b.shell_plastic_work == a.shell_plastic_work);
   CHECK(b.friction_work == a.friction_work);
 }
@@ -155,6 +157,7 @@ TEST_CASE("a checkpoint with empty sections reads back", "[checkpoint]") {
   Checkpoint a = small_checkpoint();
   a.particles = ParticleSet();
   a.shells[0].a3e.clear();
+  a.shells[0].contact_state.clear();
   a.shells[0].plastic.clear();
   const std::string path = dir.file("checkpoint.0003.bin");
   write_checkpoint(path, a);
@@ -266,6 +269,16 @@ TEST_CASE("values no run writes are refused even under a valid checksum", "[chec
     Checkpoint b = small_checkpoint();
     b.friction_work = nan;
     expect_refused(dir, b, "work is not finite");
+  }
+  {
+    Checkpoint b = small_checkpoint();
+    b.shells[0].contact_state[1] = 3;  // no ContactState
+    expect_refused(dir, b, "shell 0 has a contact state out of range");
+  }
+  {
+    Checkpoint b = small_checkpoint();
+    b.shells[0].contact_state.pop_back();
+    expect_refused(dir, b, "shell 0 contact states has 1 entries, expected 2");
   }
 }
 

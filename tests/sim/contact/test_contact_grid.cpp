@@ -8,6 +8,7 @@
 #include <map>
 #include <random>
 
+#include "sim/contact/friction_return_map.h"
 #include "sim/contact/shell_transfer.h"
 #include "sim/shell/shell_object.h"
 
@@ -48,6 +49,8 @@ struct Rig {
       const Vec3 t = a.unitOrthogonal();
       a = Real(0.7 + 0.1 * u(rng)) * a + Real(0.1 * u(rng)) * t;
     }
+    // In contact (forces() leaves out the sites a return mapping left separated).
+    contact->state.assign(contact->num_sites(), static_cast<std::uint8_t>(ContactState::Sticking));
     for (auto& v : shell->v) v.setZero();
     GridShell g;
     g.shell = shell.get();
