@@ -13,20 +13,21 @@ namespace shellmpm {
 class Solver;
 
 // The throughputs below were measured on the 2-core development machine (AMD EPYC,
-// AVX-512 dispatch) on 2026-12-05, evening; an SSE-only machine runs the bulk about 1.3x,
-// the Kirchhoff-Love forces about 2.1x and the contact points about 1.2x slower.
+// AVX-512 dispatch) on 2026-12-05 (the shells. in its last session); an SSE-only
+// machine runs the bulk about 1.3x, the Kirchhoff-Love forces about 2.1x and the contact
+// points about 1.2x slower.
 /// Seconds one thread spends on one bulk particle for one step (P2G, grid, G2P, stress):
 /// bench/mpm_throughput, APIC, float, 5.5M particle-steps/s per thread.
 constexpr double kBulkParticleStepSeconds = 1.0 / 5.5e6;
 /// Seconds one thread spends on one layer evaluation of the Kirchhoff-Love forces (one
 /// in-plane quadrature point of one triangle at one point through the thickness):
-/// bench/shell_throughput, 40.5M layer evaluations/s per thread (53M on a quieter day).
-constexpr double kShellLayerSeconds = 1.0 / 40.5e6;
+/// bench/shell_throughput, 60M layer evaluations/s per thread.
+constexpr double kShellLayerSeconds = 1.0 / 60e6;
 /// Seconds one thread spends on one control point or contact particle of a shell in
 /// contact for one step (its P2G and G2P, the contact forces, friction, the fields):
-/// bench/contact_throughput, the 113 ms of a 156 ms step not spent in the Kirchhoff-Love
+/// bench/contact_throughput, the 75 ms of a 106 ms step not spent in the Kirchhoff-Love
 /// forces, over its 298k control points and contact particles.
-constexpr double kContactPointStepSeconds = 0.113 / 298e3;
+constexpr double kContactPointStepSeconds = 0.075 / 298e3;
 
 /// What `estimate_shot` finds.
 struct ShotEstimate {
