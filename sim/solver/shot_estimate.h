@@ -13,7 +13,7 @@ namespace shellmpm {
 class Solver;
 
 // The throughputs below were measured on the 2-core development machine (AMD EPYC,
-// AVX-512 dispatch) on 2026-12-05 (the shells. in its last session); an SSE-only
+// AVX-512 dispatch) on 2026-12-05 (the shells' in its last session); an SSE-only
 // machine runs the bulk about 1.3x, the Kirchhoff-Love forces about 2.1x and the contact
 // points about 1.2x slower.
 /// Seconds one thread spends on one bulk particle for one step (P2G, grid, G2P, stress):
