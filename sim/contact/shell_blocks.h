@@ -277,7 +277,7 @@ SHELLMPM_BLOCKS_INLINE bool normal_forces(const SparseGrid& grid, const std::uin
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   for_each_site_dots(
       grid, order, table, shells, lo, hi, bc, pad, false,
-      [&](std::uint32_t g) { return !push[g]; },  // separated without shear: no force
+      [&](std::uint32_t g) { return !push[g]; },  // no force
       [&](std::uint32_t g, const QuadraticWeights& W, const Real(&t)[27][kSiteLanes], int lane) {
         using namespace stencil_row;
         const ShellContact& c = *shells[table.shell(g)].contact;

@@ -53,7 +53,7 @@ ShellFields::PointShare::PointShare(const GridShell& gs, const Vec3& nj, const V
   }
 }
 
-template <class Share, class AddFn>
+template <class AddFn>
 void ShellFields::scatter_shares(Field& F, const GridShell& gs, Real dt, bool heights, bool serial,
                                  AddFn add) {
   const ShellObject& sh = *gs.shell;
@@ -63,11 +63,11 @@ void ShellFields::scatter_shares(Field& F, const GridShell& gs, Real dt, bool he
         const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
         F.grid.for_each_point(b, [&](std::uint32_t j) {
           const QuadraticWeights W(F.grid.grid_coord(sh.x[j]));
-          const Share P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, heights);
+          const PointShare P(gs, F.normal[j], Vec3(W.fx[0], W.fx[1], W.fx[2]), j, dx, dt, heights);
           const int lx = W.base[0] - bc[0], ly = W.base[1] - bc[1], lz = W.base[2] - bc[2];
           for (int i = 0; i < 3; ++i)
             for (int jj = 0; jj < 3; ++jj) {
-              typename Share::Row r;
+              PointShare::Row r;
               P.row(i, jj, r);
               const Real wxy = W.w[0][i] * W.w[1][jj];
               for (int k = 0; k < 3; ++k) {
@@ -180,9 +180,9 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, const SparseGrid& com
       serial);
   // Straight into the nodes, colour by colour (blocks of a colour touch disjoint nodes):
   // no buffer per block to clear and gather.
-  scatter_shares<PointShare>(F, gs, dt, folds_, serial,
-                             [&](const PointShare& P, const PointShare::Row& r, int g, int node,
-                                 Real w, int k) { P.add(F.nodes[g][node], w, r, k); });
+  scatter_shares(F, gs, dt, folds_, serial,
+                 [&](const PointShare& P, const PointShare::Row& r, int g, int node, Real w,
+                     int k) { P.add(F.nodes[g][node], w, r, k); });
   // Momentum to velocity, first moment to centroid offset: right after the sums, or,
   // with fold fields, after split_folds has used the sums.
   if (!folds_) {

@@ -206,7 +206,7 @@ class ShellFields {
   /// Walks F's control points colour by colour (blocks of a colour touch disjoint nodes)
   /// and calls add(P, row, grid block, node, w, k) for each of their 27 stencil nodes, P
   /// the point's PointShare.
-  template <class Share, class AddFn>
+  template <class AddFn>
   void scatter_shares(Field& F, const GridShell& gs, Real dt, bool heights, bool serial, AddFn add);
   /// heights_only_: whether a node of the combined P2G's heights spreads (a fold).
   bool any_spread(bool serial) const;

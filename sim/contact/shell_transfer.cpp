@@ -99,12 +99,18 @@ void contact_normal_forces(SparseGrid& grid, const ShellPointTable& table,
   const std::uint32_t nc = table.num_control_points();
   const auto ns = static_cast<std::uint32_t>(table.size());
   const std::uint32_t* order = grid.order().data();
-  // The sites that push (dpsi/da3E != 0; separated sites without shear have none), one
-  // byte per table entry from nc on, read in one pass over each shell's G3.
+  // The sites that push (dpsi/da3E != 0; ShellContact::forces gives the separated ones
+  // none), one byte per table entry from nc on, read in one pass over each shell's G3.
   std::vector<std::uint8_t> pushing(ns - nc);
-  for (std::uint32_t i = 0, s = 0; s < shells.size(); ++s) {
+  for (std::size_t i0 = 0, s = 0; s < shells.size(); ++s) {
     const std::vector<Vec3>& G3 = shells[s].contact->G3;
-    for (std::size_t p = 0; p < G3.size(); ++p, ++i) pushing[i] = G3[p].squaredNorm() != 0;
+    parallel_for(
+        G3.size(), 4096,
+        [&](std::size_t b, std::size_t e) {
+          for (std::size_t p = b; p < e; ++p) pushing[i0 + p] = G3[p].squaredNorm() != 0;
+        },
+        serial);
+    i0 += G3.size();
   }
   const std::uint8_t* push = pushing.data() - nc;  // push[g] for table entries g >= nc
   // Colour by colour (blocks of a colour touch disjoint nodes): each block with pushing
