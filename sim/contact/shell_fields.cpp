@@ -88,22 +88,41 @@ void ShellFields::normalise(Node& d) {
     }
 }
 
-void ShellFields::control_normals(Field& F, const ShellObject& sh) {
-  F.normal.assign(sh.size(), Vec3::Zero());
-  for (const Eigen::Vector3i& t : sh.triangles()) {
-    const Vec3 a = (sh.x[t[1]] - sh.x[t[0]]).cross(sh.x[t[2]] - sh.x[t[0]]);
-    for (int k = 0; k < 3; ++k) F.normal[t[k]] += a;
+void ShellFields::control_normals(Field& F, const ShellObject& sh, bool serial) {
+  const auto& tris = sh.triangles();
+  const std::size_t n = sh.size();
+  if (F.tri_start.size() != n + 1) {
+    F.tri_start.assign(n + 1, 0);
+    for (const Eigen::Vector3i& t : tris)
+      for (int k = 0; k < 3; ++k) ++F.tri_start[static_cast<std::size_t>(t[k]) + 1];
+    for (std::size_t i = 0; i < n; ++i) F.tri_start[i + 1] += F.tri_start[i];
+    F.tri_of.resize(F.tri_start[n]);
+    std::vector<std::uint32_t> at(F.tri_start.begin(), F.tri_start.end() - 1);
+    for (std::size_t t = 0; t < tris.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        F.tri_of[at[static_cast<std::size_t>(tris[t][k])]++] = static_cast<std::uint32_t>(t);
   }
-  for (Vec3& n : F.normal) {
-    const Real l = n.norm();
-    n = l > 0 ? Vec3(n / l) : Vec3::Zero();
-  }
+  // Each point's area-weighted normal, its triangles in ascending order (the order a
+  // scatter over the triangles would add them in).
+  F.normal.resize(n);
+  parallel_for_each(
+      n, 4096,
+      [&](std::size_t i) {
+        Vec3 s = Vec3::Zero();
+        for (std::uint32_t k = F.tri_start[i]; k < F.tri_start[i + 1]; ++k) {
+          const Eigen::Vector3i& t = tris[F.tri_of[k]];
+          s += (sh.x[t[1]] - sh.x[t[0]]).cross(sh.x[t[2]] - sh.x[t[0]]);
+        }
+        const Real l = s.norm();
+        F.normal[i] = l > 0 ? Vec3(s / l) : Vec3::Zero();
+      },
+      serial);
 }
 
 FoldHeights* ShellFields::begin_p2g(const SparseGrid& combined,
-                                    const std::vector<GridShell>& shells) {
+                                    const std::vector<GridShell>& shells, bool serial) {
   if (!heights_only_) return nullptr;
-  control_normals(fields_[0], *shells[0].shell);
+  control_normals(fields_[0], *shells[0].shell, serial);
   heights_.normal = fields_[0].normal.data();
   heights_.align = kAlign;
   heights_.blocks.resize(combined.num_grid_blocks());  // set where points reach them
@@ -166,7 +185,7 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, const SparseGrid& com
     return;
   }
   F.x0 = sh.x;
-  control_normals(F, sh);
+  control_normals(F, sh, serial);
   F.grid.bin(sh.x, serial);
   const std::size_t ng = F.grid.num_grid_blocks();
   F.nodes.resize(ng);

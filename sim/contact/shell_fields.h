@@ -61,7 +61,8 @@ class ShellFields {
 
   /// Before the combined P2G: where one shell alone has fields (its folds' heights only),
   /// its control-point normals and the heights for shell_p2g_block to sum; else null.
-  FoldHeights* begin_p2g(const SparseGrid& combined, const std::vector<GridShell>& shells);
+  FoldHeights* begin_p2g(const SparseGrid& combined, const std::vector<GridShell>& shells,
+                         bool serial);
   /// Right after the combined P2G (the combined grid holds mass and momentum): each
   /// shell's own P2G, and the relative velocities v_b^0 - v^0 of every body at the nodes
   /// two bodies share.
@@ -149,6 +150,9 @@ class ShellFields {
     std::vector<std::array<Vec3, kBlockNodes>> r;  ///< velocity relative to the node
     std::vector<Vec3> x0;                          ///< control points at p2g time
     std::vector<Vec3> normal;                      ///< control-point unit normals
+    /// The shell's triangles at each control point, ascending: tri_of[tri_start[i] ..
+    /// tri_start[i + 1]) (built once).
+    std::vector<std::uint32_t> tri_start, tri_of;
     std::vector<int> fold;         ///< per grid block: index into folds, -1: no fold
     std::vector<FoldBlock> folds;  ///< grid blocks where the shell folds, in block order
     std::vector<int> touched;      ///< per particle block: index into the fold buffers
@@ -201,7 +205,7 @@ class ShellFields {
     }
   };
   /// F's control-point normals: the area-weighted normals of the control mesh's triangles.
-  static void control_normals(Field& F, const ShellObject& sh);
+  static void control_normals(Field& F, const ShellObject& sh, bool serial);
   void shell_p2g(Field& F, const GridShell& gs, const SparseGrid& combined, Real dt, bool serial);
   /// Walks F's control points colour by colour (blocks of a colour touch disjoint nodes)
   /// and calls add(P, row, grid block, node, w, k) for each of their 27 stencil nodes, P

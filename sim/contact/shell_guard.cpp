@@ -9,6 +9,8 @@
 namespace shellmpm {
 namespace {
 
+constexpr std::size_t kPointGrain = 4096;  ///< control points or limit vertices per chunk
+
 Vec3d to_d(const Vec3& v) {
   return v.cast<double>();
 }
@@ -375,15 +377,19 @@ double ShellGuard::load_points(const std::vector<GridShell>& shells,
   double vmax = 0;
   for (std::size_t s = 0; s < shells.size(); ++s) {
     const ShellObject& sh = *shells[s].shell;
-    for (std::size_t j = 0; j < sh.size(); ++j) {
-      const std::size_t g = point_offset_[s] + j;
-      x0_[g] = to_d(start[s][j]);
-      v_[g] = v_end_[g] = (to_d(sh.x[j]) - x0_[g]) / dt;
-      vmax = std::max(vmax, v_[g].norm());
-      const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
-      const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
-      for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
-    }
+    const auto parts = chunk_parts(
+        sh.size(), kPointGrain, serial_, 0.0, [&](std::size_t b, std::size_t e, double& m) {
+          for (std::size_t j = b; j < e; ++j) {
+            const std::size_t g = point_offset_[s] + j;
+            x0_[g] = to_d(start[s][j]);
+            v_[g] = v_end_[g] = (to_d(sh.x[j]) - x0_[g]) / dt;
+            m = std::max(m, v_[g].norm());
+            const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
+            const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
+            for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
+          }
+        });
+    for (const double m : parts) vmax = std::max(vmax, m);
   }
   return vmax;
 }
@@ -392,14 +398,17 @@ void ShellGuard::limit_positions() {
   pos_.assign(vertex_offset_.back(), Vec3d::Zero());
   for (std::size_t s = 0; s < meshes_.size(); ++s) {
     const LimitMesh& L = *meshes_[s].limit;
-    for (std::size_t row = 0; row < L.num_vertices(); ++row) {
-      const std::size_t g = vertex_offset_[s] + row;
-      const std::vector<int>& pts = L.row_points(row);
-      const std::vector<Real>& w = L.row_weights(row);
-      for (std::size_t k = 0; k < pts.size(); ++k)
-        pos_[g] +=
-            static_cast<double>(w[k]) * x0_[point_offset_[s] + static_cast<std::size_t>(pts[k])];
-    }
+    parallel_for_each(
+        L.num_vertices(), kPointGrain,
+        [&](std::size_t row) {
+          const std::size_t g = vertex_offset_[s] + row;
+          const std::vector<int>& pts = L.row_points(row);
+          const std::vector<Real>& w = L.row_weights(row);
+          for (std::size_t k = 0; k < pts.size(); ++k)
+            pos_[g] += static_cast<double>(w[k]) *
+                       x0_[point_offset_[s] + static_cast<std::size_t>(pts[k])];
+        },
+        serial_);
   }
 }
 

@@ -21,6 +21,7 @@
 #include "sim/core/check.h"
 #include "sim/core/types.h"
 #include "sim/mpm/block_hash.h"
+#include "sim/mpm/chunked_keys.h"
 
 namespace shellmpm {
 
@@ -50,7 +51,9 @@ class SparseGrid {
   void setup(double dx, const Vec3d& origin);
 
   /// Bins particle positions into particle blocks, sorts an index list by block and
-  /// allocates (and zeroes) the grid blocks they touch.
+  /// allocates the grid blocks they touch. Their nodes are set by the first
+  /// add_pad_to_grid that reaches them (the rest of the block zeroed) and by
+  /// zero_unset_blocks (particles_to_grid calls it last): read them only after those.
   void bin(const std::vector<Vec3>& x, bool serial = false) { bin(nullptr, x, serial); }
   /// Bins the concatenation of `first` (may be null) and `x`: index i < first->size()
   /// is first[i], the others x[i - first->size()].
@@ -172,8 +175,11 @@ class SparseGrid {
     const int o = ((px >> 2) << 2) | ((py >> 2) << 1) | (pz >> 2);
     return {pblock_nbr[b][o], block_node(px & 3, py & 3, pz & 3)};
   }
-  /// Adds a padded buffer of particle block b into the grid nodes it overlaps.
+  /// Adds a padded buffer of particle block b into the grid nodes it overlaps (a grid
+  /// block not yet reached since the last bin takes the buffer's nodes, 0 elsewhere).
   void add_pad_to_grid(std::size_t b, const GridNode* pad);
+  /// Zeroes the grid blocks no add_pad_to_grid has reached since the last bin.
+  void zero_unset_blocks(bool serial = false);
   /// Copies the grid nodes that particle block b's padded region overlaps into pad.
   void copy_grid_to_pad(std::size_t b, GridNode* pad) const;
   /// Calls f(grid block, node in it, node of the padded region) for every node of particle
@@ -201,19 +207,32 @@ class SparseGrid {
   void bin_points(const std::vector<Vec3>* first, const std::vector<Vec3>& x, bool serial,
                   bool with_order);
   void bin_grid_blocks(bool serial);
+  /// Per grid block, 1 until its nodes are set after a bin (the colour order makes the
+  /// blocks one colour's particle blocks reach disjoint, so no two threads share a byte's
+  /// block).
+  std::vector<std::uint8_t> gblock_unset_;
   std::vector<std::uint32_t> order_;
   std::size_t num_points_ = 0;
   double dx_ = 1.0, inv_dx_ = 1.0;
   Vec3d origin_{0, 0, 0};
   BlockHash phash_, ghash_;
   /// A run of consecutive points in one particle block: its key, first point, and its
-  /// block index (then its first slot in order).
+  /// block's index among its chunk's distinct blocks.
   struct Run {
     std::uint64_t key;
     std::uint32_t begin, block;
   };
   static constexpr std::size_t kBinChunk = 16384;  ///< points per binning chunk
-  std::vector<std::vector<Run>> chunk_runs_;       ///< per chunk, kept between calls
+  static constexpr std::size_t kGridChunk = 256;   ///< particle blocks per numbering chunk
+  /// A binning chunk's runs and, per distinct block (chunk order), its point and run
+  /// counts, then its next slots in order() and block_runs; kept between calls.
+  struct Chunk {
+    std::vector<Run> runs;
+    std::vector<std::array<std::uint32_t, 2>> counts;
+  };
+  std::vector<Chunk> chunks_;
+  ChunkedKeys pkeys_, gkeys_;  ///< particle blocks (per point chunk), grid blocks
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> column_sort_;  ///< (key, block)
   std::size_t runs_bytes() const;
 };
 

@@ -104,6 +104,7 @@ void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferPar
         grid.add_pad_to_grid(b, pad);
       },
       tp.serial);
+  grid.zero_unset_blocks(tp.serial);  // every block is reached: a scan of one byte each
 }
 
 void grid_to_particles(ParticleSet& p, SparseGrid& grid, const TransferParams& tp) {

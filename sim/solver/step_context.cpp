@@ -24,13 +24,15 @@ void StepContext::clamp_to_domain() {
     lo[a] = static_cast<Real>(s.domain_min[a] + s.dx);
     hi[a] = static_cast<Real>(s.domain_min[a] + (domain_cells[a] - 1) * s.dx);
   }
-  parallel_for_each(
-      particles.size(), kParticleGrain,
-      [&](std::size_t p) { particles.x[p] = particles.x[p].cwiseMax(lo).cwiseMin(hi); },
-      opt.serial);
+  const auto clamp = [&](std::vector<Vec3>& xs) {
+    parallel_for_each(
+        xs.size(), kParticleGrain, [&](std::size_t p) { xs[p] = xs[p].cwiseMax(lo).cwiseMin(hi); },
+        opt.serial);
+  };
+  clamp(particles.x);
   for (GridShell& g : grid_shells) {
-    for (Vec3& x : g.shell->x) x = x.cwiseMax(lo).cwiseMin(hi);
-    for (Vec3& x : g.contact->x) x = x.cwiseMax(lo).cwiseMin(hi);
+    clamp(g.shell->x);
+    clamp(g.contact->x);
   }
 }
 
