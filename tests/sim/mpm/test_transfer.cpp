@@ -156,3 +156,32 @@ TEST_CASE("sparse grid allocates only blocks near particles", "[grid]") {
   for (auto q : g.order()) seen[q]++;
   for (int s : seen) REQUIRE(s == 1);
 }
+
+TEST_CASE("a re-binned grid's nodes are those of a fresh grid", "[transfer][grid]") {
+  // The grid blocks are set where the P2G first reaches them: nothing of the last step's
+  // nodes may stay, where the blocks are reused or only partly reached.
+  std::vector<ConstitutiveModel> models(1);
+  models[0] = ConstitutiveModel::from_desc(MaterialDesc{});
+  std::vector<Real> rho{1000};
+  const TransferParams tp{1e-4f, false, false, true, &models, &rho, 0, {}};
+  ParticleSet a = random_particles(20000, 3), b = random_particles(5000, 4);
+  for (Vec3& x : b.x) x = Vec3(x[0] * Real(0.5), x[1], x[2] * Real(1.2));  // other blocks
+  SparseGrid g, fresh;
+  g.setup(1.0 / 64, Vec3d::Zero());
+  fresh.setup(1.0 / 64, Vec3d::Zero());
+  ThreadLimit lim(2);
+  g.bin(a.x);
+  particles_to_grid(a, g, tp);
+  REQUIRE(grid_totals(g, false).mass > 0);
+  g.bin(b.x);
+  particles_to_grid(b, g, tp);
+  fresh.bin(b.x);
+  particles_to_grid(b, fresh, tp);
+  REQUIRE(g.gblock_key == fresh.gblock_key);
+  REQUIRE(std::memcmp(g.gblock_nodes.data(), fresh.gblock_nodes.data(),
+                      fresh.gblock_nodes.size() * sizeof(fresh.gblock_nodes[0])) == 0);
+  // Mass: b's particles' and nothing of a's.
+  double mb = 0;
+  for (std::size_t p = 0; p < b.size(); ++p) mb += b.volume_of(p) * 1000.0;
+  CHECK(grid_totals(g, false).mass == Approx(mb).epsilon(1e-5));
+}
