@@ -102,17 +102,23 @@ void ShellFields::control_normals(Field& F, const ShellObject& sh, bool serial) 
       for (int k = 0; k < 3; ++k)
         F.tri_of[at[static_cast<std::size_t>(tris[t][k])]++] = static_cast<std::uint32_t>(t);
   }
-  // Each point's area-weighted normal, its triangles in ascending order (the order a
-  // scatter over the triangles would add them in).
+  // The triangles' area vectors, then each point's sum of its triangles' in ascending
+  // order (the order a scatter over the triangles would add them in).
+  F.tri_area.resize(tris.size());
+  parallel_for_each(
+      tris.size(), 4096,
+      [&](std::size_t i) {
+        const Eigen::Vector3i& t = tris[i];
+        F.tri_area[i] = (sh.x[t[1]] - sh.x[t[0]]).cross(sh.x[t[2]] - sh.x[t[0]]);
+      },
+      serial);
   F.normal.resize(n);
   parallel_for_each(
       n, 4096,
       [&](std::size_t i) {
         Vec3 s = Vec3::Zero();
-        for (std::uint32_t k = F.tri_start[i]; k < F.tri_start[i + 1]; ++k) {
-          const Eigen::Vector3i& t = tris[F.tri_of[k]];
-          s += (sh.x[t[1]] - sh.x[t[0]]).cross(sh.x[t[2]] - sh.x[t[0]]);
-        }
+        for (std::uint32_t k = F.tri_start[i]; k < F.tri_start[i + 1]; ++k)
+          s += F.tri_area[F.tri_of[k]];
         const Real l = s.norm();
         F.normal[i] = l > 0 ? Vec3(s / l) : Vec3::Zero();
       },

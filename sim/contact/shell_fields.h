@@ -153,6 +153,7 @@ class ShellFields {
     /// The shell's triangles at each control point, ascending: tri_of[tri_start[i] ..
     /// tri_start[i + 1]) (built once).
     std::vector<std::uint32_t> tri_start, tri_of;
+    std::vector<Vec3> tri_area;    ///< per triangle: twice its area times its unit normal
     std::vector<int> fold;         ///< per grid block: index into folds, -1: no fold
     std::vector<FoldBlock> folds;  ///< grid blocks where the shell folds, in block order
     std::vector<int> touched;      ///< per particle block: index into the fold buffers

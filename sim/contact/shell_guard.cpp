@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace shellmpm {
 namespace {
@@ -92,6 +93,7 @@ void ShellGuard::setup(const std::vector<GridShell>& shells, double gap, bool se
   vert_shell_.clear();
   for (std::size_t s = 0; s < meshes_.size(); ++s) vert_shell_.resize(vertex_offset_[s + 1], s);
   shell_list_ = {};
+  x_built_.clear();
   bulk_list_ = {};
   all_tris_.clear();
   all_edges_.clear();
@@ -151,8 +153,8 @@ void ShellGuard::build_shell_candidates(double radius) {
   vt_cand_.clear();
   ee_cand_.clear();
   const double cell = cell_size(radius);
-  tri_grid_.build(pos_, all_tris_, cell, 0.0);
-  edge_grid_.build(pos_, all_edges_, cell, 0.0);
+  tri_grid_.build(pos_, all_tris_, cell, 0.0, serial_);
+  edge_grid_.build(pos_, all_edges_, cell, 0.0, serial_);
   const Vec3d pad = Vec3d::Constant(radius);
   const auto local = [&](std::size_t g) {
     return static_cast<int>(g - vertex_offset_[vert_shell_[g]]);
@@ -228,7 +230,7 @@ void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, dou
   // are looked up.
   const ParticleSet* ps = bulk.particles;
   if (!ps || ps->size() == 0 || pos_.empty()) return;
-  bulk_grid_.build(pos_, all_tris_, cell_size(radius), 0.0);
+  bulk_grid_.build(pos_, all_tris_, cell_size(radius), 0.0, serial_);
   const Vec3d pad = Vec3d::Constant(radius);
   Vec3d lo = pos_[0], hi = pos_[0];
   for (const Vec3d& q : pos_) {
@@ -374,24 +376,46 @@ double ShellGuard::load_points(const std::vector<GridShell>& shells,
   v_end_.resize(np);
   inv_mass_.resize(np);
   x0_.resize(np);
-  double vmax = 0;
+  // The largest speed, and the box of the points' displacements since the shell list's
+  // build (where it was built for these points).
+  struct Bounds {
+    double vmax = 0;
+    Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  };
+  const bool since_build = x_built_.size() == np;
+  Bounds all;
   for (std::size_t s = 0; s < shells.size(); ++s) {
     const ShellObject& sh = *shells[s].shell;
     const auto parts = chunk_parts(
-        sh.size(), kPointGrain, serial_, 0.0, [&](std::size_t b, std::size_t e, double& m) {
+        sh.size(), kPointGrain, serial_, Bounds(), [&](std::size_t b, std::size_t e, Bounds& m) {
           for (std::size_t j = b; j < e; ++j) {
             const std::size_t g = point_offset_[s] + j;
             x0_[g] = to_d(start[s][j]);
             v_[g] = v_end_[g] = (to_d(sh.x[j]) - x0_[g]) / dt;
-            m = std::max(m, v_[g].norm());
+            m.vmax = std::max(m.vmax, v_[g].norm());
+            if (since_build) {
+              const Vec3d d = x0_[g] - x_built_[g];
+              m.lo = m.lo.cwiseMin(d);
+              m.hi = m.hi.cwiseMax(d);
+            }
             const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
             const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
             for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
           }
         });
-    for (const double m : parts) vmax = std::max(vmax, m);
+    for (const Bounds& m : parts) {
+      all.vmax = std::max(all.vmax, m.vmax);
+      all.lo = all.lo.cwiseMin(m.lo);
+      all.hi = all.hi.cwiseMax(m.hi);
+    }
   }
-  return vmax;
+  // Two points' relative displacement is within the box's diagonal (a rigid motion has
+  // none); a non-finite one (or no build yet) bounds nothing.
+  const double spread = (all.hi - all.lo).norm();
+  spread_ = since_build && np > 0 && std::isfinite(spread)
+                ? spread
+                : std::numeric_limits<double>::infinity();
+  return all.vmax;
 }
 
 void ShellGuard::limit_positions() {
@@ -556,7 +580,7 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   // Candidate lists, rebuilt when the motion since the last build could bring a pair
   // left out within reach (a pair left out was at least gap + margin apart then), and
   // the bulk list also when the particles were reordered or added.
-  const bool shell_rebuild = !shell_list_.valid(reach);
+  const bool shell_rebuild = !shell_list_.valid(reach, spread_);
   const bool bulk_rebuild =
       nb > 0 && (!bulk_list_.valid(reach_bulk) || bulk.epoch != built_epoch_ || nb != built_count_);
   if (nb == 0) bt_cand_.clear(), bulk_idx_.clear();
@@ -568,6 +592,7 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   if (shell_rebuild) {
     shell_list_.start(gap_, reach);
     build_shell_candidates(gap_ + shell_list_.margin);
+    x_built_ = x0_;
   }
   if (bulk_rebuild) {
     bulk_list_.start(gap_, reach_bulk);

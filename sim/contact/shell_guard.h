@@ -47,6 +47,7 @@
 #pragma once
 #include <algorithm>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "sim/contact/shell_transfer.h"
@@ -142,11 +143,17 @@ class ShellGuard {
   /// Adds the velocity changes to the shells' and particles' v, and dt times them to x.
   void write_back(std::vector<GridShell>& shells, ParticleSet* ps, double dt) const;
   /// A Verlet list's schedule: valid while the motion bound since its build stays
-  /// within its margin.
+  /// within its margin. The bound is the smaller of two: `moved`, the steps' relative
+  /// motion bounds summed, and (for the shell list) `spread`, the diagonal of the box of
+  /// the control points' displacements since the build, which bounds any two points'
+  /// relative displacement (and so the limit vertices', convex combinations of them)
+  /// however the points moved, and is 0 for a rigid translation.
   struct ListSchedule {
     bool built = false;
     double margin = 0, moved = 0;
-    bool valid(double reach) const { return built && moved + reach <= margin; }
+    bool valid(double reach, double spread = std::numeric_limits<double>::infinity()) const {
+      return built && std::min(moved, spread) + reach <= margin;
+    }
     void start(double gap, double reach) {
       built = true;
       margin = std::max(4.0 * gap, 4.0 * reach);
@@ -174,6 +181,8 @@ class ShellGuard {
   // Per pass (kept to reuse their memory).
   std::vector<Vec3d> pos_;       ///< limit vertices of all shells at x^n
   std::vector<Vec3d> x0_;        ///< control points at x^n
+  std::vector<Vec3d> x_built_;   ///< x0_ at the shell list's last build
+  double spread_ = 0;            ///< load_points: the displacements' box diagonal since then
   std::vector<Vec3d> v_end_;     ///< (x - x^n) / dt before the guard
   std::vector<Vec3d> v_;         ///< control velocities (double) being corrected
   std::vector<Vec3d> inv_mass_;  ///< per control point and component

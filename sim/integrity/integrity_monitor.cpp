@@ -101,7 +101,7 @@ void IntegrityMonitor::refresh(const IntegrityView& view) {
       g.pos[i] = p[i].cast<double>();
       g.nrm[i] = n[i].cast<double>();
     }
-    g.grid.build(g.pos, g.limit->triangles(), 2.0 * band_, band_);
+    g.grid.build(g.pos, g.limit->triangles(), 2.0 * band_, band_, view.serial);
   }
 }
 

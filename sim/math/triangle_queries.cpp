@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "sim/core/parallel.h"
+
 namespace shellmpm {
 
 Vec3d closest_point_barycentric(const Vec3d& p, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
@@ -91,50 +93,114 @@ Vec3i TriangleGrid::cell_of(const Vec3d& p) const {
 }
 
 void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen::Vector3i>& tris,
-                         double cell, double pad) {
+                         double cell, double pad, bool serial) {
   inv_cell_ = 1.0 / cell;
-  std::vector<std::pair<std::uint64_t, int>> pairs;
-  pairs.reserve(tris.size() * 4);
-  for (std::size_t t = 0; t < tris.size(); ++t) {
+  const std::size_t nt = tris.size();
+  // Each triangle's cells (none for a non-finite one), counted, then listed at its offset.
+  auto cells_of = [&](std::size_t t, Vec3i& c0, Vec3i& c1) {
     Vec3d lo = pos[tris[t][0]], hi = lo;
     for (int k = 1; k < 3; ++k) {
       lo = lo.cwiseMin(pos[tris[t][k]]);
       hi = hi.cwiseMax(pos[tris[t][k]]);
     }
-    if (!lo.allFinite() || !hi.allFinite()) continue;
-    const Vec3i c0 = cell_of(lo.array() - pad), c1 = cell_of(hi.array() + pad);
-    for (int i = c0[0]; i <= c1[0]; ++i)
-      for (int j = c0[1]; j <= c1[1]; ++j)
-        for (int k = c0[2]; k <= c1[2]; ++k)
-          pairs.emplace_back(key(Vec3i(i, j, k)), static_cast<int>(t));
+    if (!lo.allFinite() || !hi.allFinite()) return false;
+    c0 = cell_of(lo.array() - pad);
+    c1 = cell_of(hi.array() + pad);
+    return true;
+  };
+  std::vector<std::size_t> start(nt + 1, 0);
+  parallel_for_each(
+      nt, 4096,
+      [&](std::size_t t) {
+        Vec3i c0, c1;
+        if (cells_of(t, c0, c1))
+          start[t + 1] = static_cast<std::size_t>(c1[0] - c0[0] + 1) *
+                         static_cast<std::size_t>(c1[1] - c0[1] + 1) *
+                         static_cast<std::size_t>(c1[2] - c0[2] + 1);
+      },
+      serial);
+  for (std::size_t t = 0; t < nt; ++t) start[t + 1] += start[t];
+  pairs_.resize(start[nt]);
+  parallel_for_each(
+      nt, 4096,
+      [&](std::size_t t) {
+        Vec3i c0, c1;
+        if (!cells_of(t, c0, c1)) return;
+        std::size_t at = start[t];
+        for (int i = c0[0]; i <= c1[0]; ++i)
+          for (int j = c0[1]; j <= c1[1]; ++j)
+            for (int k = c0[2]; k <= c1[2]; ++k)
+              pairs_[at++] = {key(Vec3i(i, j, k)), static_cast<int>(t)};
+      },
+      serial);
+  // A stable counting sort by cell, cells numbered by first appearance: per chunk of
+  // pairs its distinct cells and their counts (in parallel), the cells' numbers and each
+  // chunk's first slot per cell (once per distinct cell of a chunk), then the triangles
+  // into place (in parallel). The pairs are in triangle order, so each cell lists its
+  // triangles ascending, for any thread count.
+  const std::size_t np = pairs_.size(), nc = (np + kChunk - 1) / kChunk;
+  chunk_keys_.resize(nc);
+  if (chunk_slots_.size() < nc) chunk_slots_.resize(nc);
+  std::vector<int>& cell_of_pair = pair_cell_;
+  cell_of_pair.resize(np);
+  parallel_for_each(
+      nc, 1,
+      [&](std::size_t c) {
+        chunk_keys_.begin_chunk(c);
+        std::vector<std::size_t>& counts = chunk_slots_[c];
+        counts.clear();
+        for (std::size_t i = c * kChunk; i < std::min(np, (c + 1) * kChunk); ++i) {
+          const int id = chunk_keys_.local(c, pairs_[i].first);
+          if (static_cast<std::size_t>(id) == counts.size()) counts.push_back(0);
+          ++counts[static_cast<std::size_t>(id)];
+          cell_of_pair[i] = id;
+        }
+      },
+      serial);
+  cells_.clear();
+  std::vector<std::uint64_t> cell_keys;
+  chunk_keys_.number(cells_, cell_keys);
+  cell_start_.assign(cell_keys.size() + 1, 0);
+  for (std::size_t c = 0; c < nc; ++c)
+    for (std::size_t l = 0; l < chunk_slots_[c].size(); ++l)
+      cell_start_[static_cast<std::size_t>(chunk_keys_.global(c, static_cast<int>(l))) + 1] +=
+          chunk_slots_[c][l];
+  for (std::size_t g = 0; g < cell_keys.size(); ++g) cell_start_[g + 1] += cell_start_[g];
+  {
+    std::vector<std::size_t> next(cell_start_.begin(), cell_start_.end() - 1);
+    for (std::size_t c = 0; c < nc; ++c)
+      for (std::size_t l = 0; l < chunk_slots_[c].size(); ++l) {
+        std::size_t& n = next[static_cast<std::size_t>(chunk_keys_.global(c, static_cast<int>(l)))];
+        const std::size_t first = n;
+        n += chunk_slots_[c][l];
+        chunk_slots_[c][l] = first;  // from here the chunk's next slot in that cell
+      }
   }
-  std::sort(pairs.begin(), pairs.end());
-  keys_.resize(pairs.size());
-  tri_.resize(pairs.size());
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
-    keys_[i] = pairs[i].first;
-    tri_[i] = pairs[i].second;
+  tri_.resize(np);
+  parallel_for_each(
+      nc, 1,
+      [&](std::size_t c) {
+        std::vector<std::size_t>& slot = chunk_slots_[c];
+        for (std::size_t i = c * kChunk; i < std::min(np, (c + 1) * kChunk); ++i)
+          tri_[slot[static_cast<std::size_t>(cell_of_pair[i])]++] = pairs_[i].second;
+      },
+      serial);
+  // The work space goes where it was large (a first build before the mesh moved apart).
+  if (pairs_.capacity() > 2 * np + 4096) {
+    std::vector<std::pair<std::uint64_t, int>>().swap(pairs_);
+    std::vector<int>().swap(pair_cell_);
   }
 }
 
 void TriangleGrid::query(const Vec3d& p, std::vector<int>& out) const {
   out.clear();
   if (!p.allFinite()) return;
-  const std::uint64_t k = key(cell_of(p));
-  const auto r = std::equal_range(keys_.begin(), keys_.end(), k);
-  for (auto it = r.first; it != r.second; ++it) out.push_back(tri_[it - keys_.begin()]);
+  for_each_in_box(p, p, [&](int t) { out.push_back(t); });
 }
 
 void TriangleGrid::query_box(const Vec3d& lo, const Vec3d& hi, std::vector<int>& out) const {
   out.clear();
-  if (!lo.allFinite() || !hi.allFinite()) return;
-  const Vec3i c0 = cell_of(lo), c1 = cell_of(hi);
-  for (int i = c0[0]; i <= c1[0]; ++i)
-    for (int j = c0[1]; j <= c1[1]; ++j)
-      for (int k = c0[2]; k <= c1[2]; ++k) {
-        const auto r = std::equal_range(keys_.begin(), keys_.end(), key(Vec3i(i, j, k)));
-        for (auto it = r.first; it != r.second; ++it) out.push_back(tri_[it - keys_.begin()]);
-      }
+  for_each_in_box(lo, hi, [&](int t) { out.push_back(t); });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "sim/core/block_hash.h"
+#include "sim/core/chunked_keys.h"
 #include "sim/core/types.h"
 
 namespace shellmpm {
@@ -28,11 +30,12 @@ bool segment_crosses_triangle(const Vec3d& p, const Vec3d& q, const Vec3d& a, co
                               const Vec3d& c);
 
 /// Triangles binned into cubic cells of side `cell`, each triangle in every cell that
-/// its bounding box grown by `pad` overlaps. Deterministic (sorted pairs).
+/// its bounding box grown by `pad` overlaps. Deterministic (a stable counting sort by
+/// cell); a cell's listings are found by hash, not by search.
 class TriangleGrid {
  public:
   void build(const std::vector<Vec3d>& pos, const std::vector<Eigen::Vector3i>& tris, double cell,
-             double pad);
+             double pad, bool serial = false);
   /// Triangles listed in the cell that holds p (a superset of those within `pad` of p).
   void query(const Vec3d& p, std::vector<int>& out) const;
   /// Triangles listed in any cell that the box [lo, hi] overlaps, sorted, no repeats.
@@ -46,19 +49,30 @@ class TriangleGrid {
     for (int i = c0[0]; i <= c1[0]; ++i)
       for (int j = c0[1]; j <= c1[1]; ++j)
         for (int k = c0[2]; k <= c1[2]; ++k) {
-          const std::uint64_t key_ijk = key(Vec3i(i, j, k));
-          auto it = std::lower_bound(keys_.begin(), keys_.end(), key_ijk);
-          for (; it != keys_.end() && *it == key_ijk; ++it) fn(tri_[it - keys_.begin()]);
+          const int c = cells_.find(key(Vec3i(i, j, k)));
+          if (c < 0) continue;
+          const std::size_t e = cell_start_[static_cast<std::size_t>(c) + 1];
+          for (std::size_t l = cell_start_[static_cast<std::size_t>(c)]; l < e; ++l) fn(tri_[l]);
         }
   }
-  bool empty() const { return keys_.empty(); }
+  bool empty() const { return tri_.empty(); }
 
  private:
   std::uint64_t key(const Vec3i& c) const;
   Vec3i cell_of(const Vec3d& p) const;
   double inv_cell_ = 1;
-  std::vector<std::uint64_t> keys_;  ///< sorted cell keys, one per (cell, triangle) pair
-  std::vector<int> tri_;             ///< triangle of each pair
+  /// The triangles tri_[cell_start_[c] .. cell_start_[c + 1]) in the cell numbered c by
+  /// cells_ (cells by first appearance in triangle order), ascending.
+  std::vector<int> tri_;
+  std::vector<std::size_t> cell_start_;
+  BlockHash cells_;
+  // build's work space, kept: the (cell key, triangle) pairs in triangle order, each
+  // pair's cell among its chunk's, per chunk its cells' counts (then next slots).
+  static constexpr std::size_t kChunk = 16384;
+  std::vector<std::pair<std::uint64_t, int>> pairs_;
+  std::vector<int> pair_cell_;
+  ChunkedKeys chunk_keys_;
+  std::vector<std::vector<std::size_t>> chunk_slots_;
 };
 
 }  // namespace shellmpm

@@ -18,10 +18,10 @@
 #include <utility>
 #include <vector>
 
+#include "sim/core/block_hash.h"
 #include "sim/core/check.h"
+#include "sim/core/chunked_keys.h"
 #include "sim/core/types.h"
-#include "sim/mpm/block_hash.h"
-#include "sim/mpm/chunked_keys.h"
 
 namespace shellmpm {
 

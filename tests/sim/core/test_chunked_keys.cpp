@@ -6,8 +6,8 @@
 #include <map>
 #include <random>
 
+#include "sim/core/chunked_keys.h"
 #include "sim/core/parallel.h"
-#include "sim/mpm/chunked_keys.h"
 #include "sim/mpm/sparse_grid.h"
 
 using namespace shellmpm;

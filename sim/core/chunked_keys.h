@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "sim/mpm/block_hash.h"
+#include "sim/core/block_hash.h"
 
 namespace shellmpm {
 
