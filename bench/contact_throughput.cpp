@@ -22,6 +22,9 @@ using namespace shellmpm;
 
 int main(int argc, char** argv) {
   shellmpm_bench::SheetArgs args;
+  // 100 steps: the shell guard rebuilds its candidate lists every few dozen steps here
+  // (about 0.1 s each), so a shorter window may leave them out.
+  args.steps = 100;
   if (!shellmpm_bench::parse_sheet_args(argc, argv, args)) return 2;
   const int steps = args.steps;
   const int n = args.quads_per_side();
