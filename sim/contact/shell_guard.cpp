@@ -465,15 +465,11 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells, const GuardBul
   return apply(shells, start, bulk, dt);
 }
 
-double ShellGuard::load_points(const std::vector<GridShell>& shells,
-                               const std::vector<std::vector<Vec3>>& start, double dt) {
-  const std::size_t np = point_offset_.back();
-  v_.resize(np);
-  v_end_.resize(np);
-  inv_mass_.resize(np);
-  x0_.resize(np);
+double ShellGuard::point_bounds(const std::vector<GridShell>& shells,
+                                const std::vector<std::vector<Vec3>>& start, double dt) {
   // The largest speed, and the box of the points' displacements since the shell list's
-  // build (where it was built for these points).
+  // build (where it was built for these points): reads only, every step.
+  const std::size_t np = point_offset_.back();
   struct Bounds {
     double vmax = 0;
     Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -485,18 +481,13 @@ double ShellGuard::load_points(const std::vector<GridShell>& shells,
     const auto parts = chunk_parts(
         sh.size(), kPointGrain, serial_, Bounds(), [&](std::size_t b, std::size_t e, Bounds& m) {
           for (std::size_t j = b; j < e; ++j) {
-            const std::size_t g = point_offset_[s] + j;
-            x0_[g] = to_d(start[s][j]);
-            v_[g] = v_end_[g] = (to_d(sh.x[j]) - x0_[g]) / dt;
-            m.vmax = std::max(m.vmax, v_[g].norm());
+            const Vec3d x0 = to_d(start[s][j]);
+            m.vmax = std::max(m.vmax, ((to_d(sh.x[j]) - x0) / dt).norm());
             if (since_build) {
-              const Vec3d d = x0_[g] - x_built_[g];
+              const Vec3d d = x0 - x_built_[point_offset_[s] + j];
               m.lo = m.lo.cwiseMin(d);
               m.hi = m.hi.cwiseMax(d);
             }
-            const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
-            const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
-            for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
           }
         });
     for (const Bounds& m : parts) {
@@ -512,6 +503,29 @@ double ShellGuard::load_points(const std::vector<GridShell>& shells,
                 ? spread
                 : std::numeric_limits<double>::infinity();
   return all.vmax;
+}
+
+void ShellGuard::load_points(const std::vector<GridShell>& shells,
+                             const std::vector<std::vector<Vec3>>& start, double dt) {
+  const std::size_t np = point_offset_.back();
+  v_.resize(np);
+  v_end_.resize(np);
+  inv_mass_.resize(np);
+  x0_.resize(np);
+  for (std::size_t s = 0; s < shells.size(); ++s) {
+    const ShellObject& sh = *shells[s].shell;
+    parallel_for_each(
+        sh.size(), kPointGrain,
+        [&](std::size_t j) {
+          const std::size_t g = point_offset_[s] + j;
+          x0_[g] = to_d(start[s][j]);
+          v_[g] = v_end_[g] = (to_d(sh.x[j]) - x0_[g]) / dt;
+          const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
+          const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
+          for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
+        },
+        serial_);
+  }
 }
 
 void ShellGuard::limit_positions() {
@@ -661,7 +675,7 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   // Control points: start-of-step positions, and the velocity that takes them to where
   // they are now ((x - x^n) / dt: G2P's velocity, plus a collider's projection where one
   // moved the point), which the constraints act on.
-  const double vmax = load_points(shells, start, dt);
+  const double vmax = point_bounds(shells, start, dt);
   // Speed bounds: the limit vertices are convex combinations of the control points (Loop
   // limit weights are positive), so the largest control-point speed bounds theirs.
   ParticleSet* const ps = bulk.particles;
@@ -683,7 +697,8 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   shell_list_.moved += reach;
   bulk_list_.moved += reach_bulk;
   if (!shell_rebuild && !bulk_rebuild && vt_cand_.empty() && ee_cand_.empty() && bt_cand_.empty())
-    return st;        // nothing near, and the lists still hold
+    return st;  // nothing near, and the lists still hold
+  load_points(shells, start, dt);
   limit_positions();  // at x^n
   if (shell_rebuild) {
     shell_list_.start(gap_, reach);

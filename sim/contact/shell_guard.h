@@ -127,10 +127,12 @@ class ShellGuard {
   void build_bulk_candidates(double radius, const GuardBulk& bulk, double dt);
   double cell_size(double radius) const;
   // Steps of apply(), in order.
-  /// x0_, v_ = v_end_ = (x - x^n) / dt and inv_mass_ of the control points; returns the
-  /// largest control-point speed.
-  double load_points(const std::vector<GridShell>& shells,
-                     const std::vector<std::vector<Vec3>>& start, double dt);
+  /// The largest control-point speed |x - x^n| / dt (returned) and spread_.
+  double point_bounds(const std::vector<GridShell>& shells,
+                      const std::vector<std::vector<Vec3>>& start, double dt);
+  /// x0_, v_ = v_end_ = (x - x^n) / dt and inv_mass_ of the control points.
+  void load_points(const std::vector<GridShell>& shells,
+                   const std::vector<std::vector<Vec3>>& start, double dt);
   /// pos_: the limit vertices at x0_.
   void limit_positions();
   /// The bulk candidates' velocities, inverse masses and x^n after the control points.
@@ -182,7 +184,7 @@ class ShellGuard {
   std::vector<Vec3d> pos_;       ///< limit vertices of all shells at x^n
   std::vector<Vec3d> x0_;        ///< control points at x^n
   std::vector<Vec3d> x_built_;   ///< x0_ at the shell list's last build
-  double spread_ = 0;            ///< load_points: the displacements' box diagonal since then
+  double spread_ = 0;            ///< point_bounds: the displacements' box diagonal since then
   std::vector<Vec3d> v_end_;     ///< (x - x^n) / dt before the guard
   std::vector<Vec3d> v_;         ///< control velocities (double) being corrected
   std::vector<Vec3d> inv_mass_;  ///< per control point and component
