@@ -90,47 +90,6 @@ class Stamps {
   std::uint64_t pass_;
 };
 
-/// The features already seen for one item at a time: a small open-addressing set that
-/// stays in cache (the features near one item are few), each slot tagged with the item so
-/// that nothing is cleared between items; an item with more features than it holds goes
-/// on in Stamps.
-class Seen {
- public:
-  Seen(std::size_t n, std::uint32_t pass) : stamps_(n, pass) {}
-  /// Starts item i.
-  void start(std::size_t i) {
-    ++tag_;
-    count_ = 0;
-    item_ = i;
-  }
-  /// True the first time f is seen for the current item.
-  bool first(int f) {
-    if (count_ > kMax) return stamps_.first(f, item_);
-    const std::uint64_t key =
-        (static_cast<std::uint64_t>(tag_) << 32) | static_cast<std::uint32_t>(f);
-    for (std::uint32_t h = (static_cast<std::uint32_t>(f) * 0x9E3779B1u) >> (32 - kBits);;
-         h = (h + 1) & (kSlots - 1)) {
-      if (slot_[h] == key) return false;
-      if (slot_[h] >> 32 != tag_) {
-        slot_[h] = key;
-        if (++count_ > kMax)  // full: this item's features go on as marks
-          for (const std::uint64_t k : slot_)
-            if (k >> 32 == tag_)
-              stamps_.first(static_cast<int>(static_cast<std::uint32_t>(k)), item_);
-        return true;
-      }
-    }
-  }
-
- private:
-  static constexpr int kBits = 10;
-  static constexpr std::uint32_t kSlots = 1u << kBits, kMax = kSlots / 2;
-  std::array<std::uint64_t, kSlots> slot_{};
-  std::uint32_t tag_ = 0, count_ = 0;
-  std::size_t item_ = 0;
-  Stamps stamps_;
-};
-
 double distance_of_segments(const Vec3d& p0, const Vec3d& p1, const Vec3d& q0, const Vec3d& q1) {
   const Eigen::Vector2d st = closest_segment_params(p0, p1, q0, q1);
   return ((p0 + st[0] * (p1 - p0)) - (q0 + st[1] * (q1 - q0))).norm();
@@ -232,24 +191,6 @@ void ShellGuard::build_shell_candidates(double radius) {
   const auto local = [&](std::size_t g) {
     return static_cast<int>(g - vertex_offset_[vert_shell_[g]]);
   };
-  // A same-shell pair whose features were nearer than `near` at rest is no candidate (the
-  // rest test below); a feature's distance is at most that of any two of their corners,
-  // so two corners nearer than that at rest settle it without the distance. For a point
-  // and a triangle: p against the corners q; for two edges (edge: p and q[0] against
-  // q[1], q[2]).
-  const auto rest_near_corner = [&](std::size_t p, std::array<int, 3> q, bool edges = false) {
-    const std::size_t s = vert_shell_[p];
-    const std::vector<Vec3d>& R = meshes_[s].rest;
-    const double near2 = meshes_[s].near * meshes_[s].near;
-    for (int k = edges ? 1 : 0; k < 3; ++k) {
-      const auto qk = static_cast<std::size_t>(q[static_cast<std::size_t>(k)]);
-      if (vert_shell_[qk] != s) return false;
-      if ((R[local(p)] - R[local(qk)]).squaredNorm() < near2) return true;
-      if (edges && (R[local(static_cast<std::size_t>(q[0]))] - R[local(qk)]).squaredNorm() < near2)
-        return true;
-    }
-    return false;
-  };
   // Vertices, then edges, in chunks on the threads; each chunk keeps its own pairs, and
   // the chunks' pairs are joined in order (the same lists on any thread count).
   const std::size_t grain = 512;
@@ -259,11 +200,10 @@ void ShellGuard::build_shell_candidates(double radius) {
     const auto parts =
         chunk_parts(n, grain, serial_, std::vector<Eigen::Vector2i>(),
                     [&](std::size_t b, std::size_t e, std::vector<Eigen::Vector2i>& part) {
-                      Seen stamp(stamps, pass);
+                      Stamps stamp(stamps, pass);
                       std::vector<int> cand;
                       for (std::size_t i = b; i < e; ++i) {
                         cand.clear();
-                        stamp.start(i);
                         visit(i, stamp, cand);
                         std::sort(cand.begin(), cand.end());
                         for (int f : cand) part.emplace_back(static_cast<int>(i), f);
@@ -272,13 +212,12 @@ void ShellGuard::build_shell_candidates(double radius) {
     for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
   };
   chunked(pos_.size(), all_tris_.size(), vt_cand_,
-          [&](std::size_t p, Seen& stamp, std::vector<int>& cand) {
+          [&](std::size_t p, Stamps& stamp, std::vector<int>& cand) {
             const int pi = static_cast<int>(p);
             tri_grid_.for_each_in_box(pos_[p] - pad, pos_[p] + pad, [&](int t) {
-              if (!stamp.first(t)) return;
+              if (!stamp.first(t, p)) return;
               const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
               if (T[0] == pi || T[1] == pi || T[2] == pi) return;
-              if (rest_near_corner(p, {T[0], T[1], T[2]})) return;
               if (boxes_apart<1, 3>({&pos_[p]}, {&pos_[T[0]], &pos_[T[1]], &pos_[T[2]]}, radius))
                 return;
               if (!(distance_to_triangle(pos_[p], pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius))
@@ -294,16 +233,14 @@ void ShellGuard::build_shell_candidates(double radius) {
             });
           });
   chunked(all_edges_.size(), all_edges_.size(), ee_cand_,
-          [&](std::size_t e, Seen& stamp, std::vector<int>& cand) {
+          [&](std::size_t e, Stamps& stamp, std::vector<int>& cand) {
             const Eigen::Vector3i& E = all_edges_[e];
             const Vec3d &p0 = pos_[E[0]], &p1 = pos_[E[1]];
             const int ei = static_cast<int>(e);
             edge_grid_.for_each_in_box(p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad, [&](int f) {
-              if (f <= ei || !stamp.first(f)) return;
+              if (f <= ei || !stamp.first(f, e)) return;
               const Eigen::Vector3i& F = all_edges_[static_cast<std::size_t>(f)];
               if (F[0] == E[0] || F[0] == E[1] || F[1] == E[0] || F[1] == E[1]) return;
-              if (rest_near_corner(static_cast<std::size_t>(E[0]), {E[1], F[0], F[1]}, true))
-                return;
               if (boxes_apart<2, 2>({&p0, &p1}, {&pos_[F[0]], &pos_[F[1]]}, radius)) return;
               if (!(distance_of_segments(p0, p1, pos_[F[0]], pos_[F[1]]) < radius)) return;
               const std::size_t s = vert_shell_[E[0]];
@@ -341,15 +278,14 @@ void ShellGuard::build_bulk_candidates(double radius, const GuardBulk& bulk, dou
   const std::uint32_t pass = Stamps::new_pass();
   const std::vector<Pairs> parts =
       chunk_parts(n, grain, serial_, Pairs(), [&](std::size_t b, std::size_t e, Pairs& out) {
-        Seen stamp(all_tris_.size(), pass);
+        Stamps stamp(all_tris_.size(), pass);
         std::vector<int> cand;
         for (std::size_t p = b; p < e; ++p) {
           const Vec3d x = to_d(ps->x[p]) - dt * to_d(ps->v[p]);
           if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any()) continue;
           cand.clear();
-          stamp.start(p);
           bulk_grid_.for_each_in_box(x - pad, x + pad, [&](int t) {
-            if (!stamp.first(t)) return;
+            if (!stamp.first(t, p)) return;
             const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
             if (boxes_apart<1, 3>({&x}, {&pos_[T[0]], &pos_[T[1]], &pos_[T[2]]}, radius)) return;
             if (distance_to_triangle(x, pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius)

@@ -141,8 +141,7 @@ void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen:
   const std::size_t np = pairs_.size(), nc = (np + kChunk - 1) / kChunk;
   chunk_keys_.resize(nc);
   if (chunk_slots_.size() < nc) chunk_slots_.resize(nc);
-  std::vector<int>& cell_of_pair = pair_cell_;
-  cell_of_pair.resize(np);
+  pair_cell_.resize(np);
   parallel_for_each(
       nc, 1,
       [&](std::size_t c) {
@@ -153,7 +152,7 @@ void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen:
           const int id = chunk_keys_.local(c, pairs_[i].first);
           if (static_cast<std::size_t>(id) == counts.size()) counts.push_back(0);
           ++counts[static_cast<std::size_t>(id)];
-          cell_of_pair[i] = id;
+          pair_cell_[i] = id;
         }
       },
       serial);
@@ -182,7 +181,7 @@ void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen:
       [&](std::size_t c) {
         std::vector<std::size_t>& slot = chunk_slots_[c];
         for (std::size_t i = c * kChunk; i < std::min(np, (c + 1) * kChunk); ++i)
-          tri_[slot[static_cast<std::size_t>(cell_of_pair[i])]++] = pairs_[i].second;
+          tri_[slot[static_cast<std::size_t>(pair_cell_[i])]++] = pairs_[i].second;
       },
       serial);
   // The work space goes where it was large (a first build before the mesh moved apart).

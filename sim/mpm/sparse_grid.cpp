@@ -210,7 +210,6 @@ void SparseGrid::bin_grid_blocks(bool serial) {
   // in cache (a zeroing pass here wrote and the P2G read back every node once more).
   gblock_nodes.resize(ng);
   gblock_unset_.assign(ng, 1);
-  (void)serial;
 }
 
 void SparseGrid::zero_unset_blocks(bool serial) {
