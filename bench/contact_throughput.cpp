@@ -71,25 +71,25 @@ int main(int argc, char** argv) {
     solver.advance_to(3 * h / 1.5);
     const shellmpm_bench::TimedAdvance run = shellmpm_bench::timed_advance(solver, steps * dt);
     const FrameStats& fs = run.stats;
-    // Per-frame work (the reorder, the integrity monitor's first and frame-end checks) runs
-    // once in the timed advance but once in ~900 steps of a real frame: counted apart.
-    double frame_sec = 0;
-    for (const auto& [name, v] : fs.stage_seconds)
-      if (name == "reorder" || name == "integrity_frame") frame_sec += v;
+    // Per-frame work (the reorder, the integrity monitor's first and frame-end checks, the
+    // frame's statistics) runs once in the timed advance but once in ~900 steps of a real
+    // frame: counted apart.
+    const double frame_sec = shellmpm_bench::per_frame_seconds(fs);
     const double sec = run.seconds - frame_sec;
     const double per_step = sec / fs.substeps;
     const double steps_per_frame = std::ceil(1.0 / (s.shot.fps * dt));
     if (base == 0) base = per_step;
     std::printf(
         "threads %d: %.1f ms per step, %.0f steps per frame -> %.1f s per frame "
-        "(%.0f ms, and %.0f ms of per-frame checks and reorder); speed-up %.2fx; in contact "
+        "(%.0f ms, and %.0f ms of per-frame checks, statistics and reorder); speed-up %.2fx; in "
+        "contact "
         "%zu, sliding %zu\n",
         t, 1e3 * per_step, steps_per_frame, per_step * steps_per_frame,
         1e3 * per_step * steps_per_frame, 1e3 * frame_sec, base / per_step, fs.contact_compressed,
         fs.contact_sliding);
     std::map<std::string, double> groups;
     for (const auto& [name, v] : fs.stage_seconds) {
-      if (name == "reorder" || name == "integrity_frame") continue;
+      if (shellmpm_bench::per_frame_stage(name)) continue;
       std::string g = name;
       if (name == "bin" || name == "p2g" || name == "g2p" || name == "grid") g = "transfers+grid";
       if (name == "contact" || name == "contact_grid") g = "contact forces";
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     for (const auto& [g, v] : groups) std::printf("  %s %.1f ms", g.c_str(), 1e3 * v / fs.substeps);
     std::printf("\n  stages:");
     for (const auto& [name, v] : fs.stage_seconds)
-      if (name != "reorder" && name != "integrity_frame" && v > 0)
+      if (!shellmpm_bench::per_frame_stage(name) && v > 0)
         std::printf("  %s %.1f", name.c_str(), 1e3 * v / fs.substeps);
     std::printf("\n");
   }

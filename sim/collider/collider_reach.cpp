@@ -16,11 +16,11 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
   const std::size_t nk = std::min<std::size_t>(colliders.size(), 32);
   const double dx = grid.dx();
   buf_.resize(nb);
+  touched_.assign(nb, 0);
   parallel_for_each(
       nb, 4,
       [&](std::size_t b) {
         std::array<std::uint32_t, kPadNodes>& buf = buf_[b];
-        buf.fill(0);
         const Vec3i corner = unpack_block(grid.pblock_key[b]) * kBlockSize;
         // The block's points and the nodes they reach lie within 2.5 dx of its cells; a
         // point that moves further in a step is caught by the particle projection.
@@ -37,6 +37,7 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
           if (colliders[k].bounds().overlaps(box) && colliders[k].phi(centre) <= radius + reach)
             near |= 1u << k;
         if (!near) return;
+        bool touched = false;
         grid.for_each_point(b, [&](std::uint32_t i) {
           const Vec3& p = i < nf ? (*first)[i] : x[i - nf];
           const Vec3d pd = p.cast<double>();
@@ -46,6 +47,8 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
             if (((near >> k) & 1u) && std::min(colliders[k].phi(pd), colliders[k].phi(pe)) <= reach)
               bits |= 1u << k;
           if (!bits) return;
+          if (!touched) buf.fill(0);
+          touched = true;
           const QuadraticWeights W(grid.grid_coord(p));
           const int lx = W.base[0] - corner[0], ly = W.base[1] - corner[1],
                     lz = W.base[2] - corner[2];
@@ -53,17 +56,31 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
             for (int c = 0; c < 3; ++c)
               for (int d = 0; d < 3; ++d) buf[pad_node(lx + a, ly + c, lz + d)] |= bits;
         });
+        touched_[b] = touched;
       },
       serial);
-  mask_.assign(grid.num_grid_blocks() * kBlockNodes, 0);
+  // Marks only for the grid blocks that gather from a marked buffer (numbered in block
+  // order); the others engage nothing.
+  const std::size_t ng = grid.num_grid_blocks();
+  slot_.resize(ng);
+  std::uint32_t slots = 0;
+  for (std::size_t g = 0; g < ng; ++g) {
+    bool any = false;
+    for (int src : grid.gblock_src[g]) any = any || (src >= 0 && touched_[std::size_t(src)]);
+    slot_[g] = any ? slots++ : kNone;
+  }
+  mask_.assign(std::size_t(slots) * kBlockNodes, 0);
   parallel_for_each(
-      grid.num_grid_blocks(), 16,
+      ng, 16,
       [&](std::size_t g) {
+        if (slot_[g] == kNone) return;
+        std::uint32_t* m = &mask_[std::size_t(slot_[g]) * kBlockNodes];
         grid.for_each_buffer_node(g, [&](int bn, std::size_t src, int pn) {
-          mask_[g * kBlockNodes + static_cast<std::size_t>(bn)] |= buf_[src][pn];
+          if (touched_[src]) m[bn] |= buf_[src][pn];
         });
       },
       serial);
+  computed_ = true;
 }
 
 std::size_t ColliderReach::count() const {

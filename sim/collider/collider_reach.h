@@ -44,15 +44,23 @@ class ColliderReach {
   /// Whether node n of grid block g takes collider k's condition. Colliders past the
   /// 32nd, and every collider before compute, always do.
   bool engaged(std::size_t g, int n, std::size_t k) const {
-    if (k >= 32 || mask_.empty()) return true;
-    return (mask_[g * kBlockNodes + static_cast<std::size_t>(n)] >> k) & 1u;
+    if (k >= 32 || !computed_) return true;
+    const std::uint32_t s = slot_[g];
+    if (s == kNone) return false;
+    return (mask_[std::size_t(s) * kBlockNodes + static_cast<std::size_t>(n)] >> k) & 1u;
   }
   /// Nodes that take some collider's condition (for tests and statistics).
   std::size_t count() const;
 
  private:
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  bool computed_ = false;
+  /// Per grid block, where its nodes' marks are in mask_ (kBlockNodes from
+  /// slot * kBlockNodes), or kNone: no point of a block it gathers from came near.
+  std::vector<std::uint32_t> slot_;
   std::vector<std::uint32_t> mask_;
   std::vector<std::array<std::uint32_t, kPadNodes>> buf_;
+  std::vector<std::uint8_t> touched_;  ///< per particle block: buf_ holds a mark
 };
 
 }  // namespace shellmpm

@@ -125,6 +125,9 @@ void ShellGuard::setup(const std::vector<GridShell>& shells, double gap, bool se
   vert_shell_.clear();
   for (std::size_t s = 0; s < meshes_.size(); ++s) vert_shell_.resize(vertex_offset_[s + 1], s);
   shell_list_ = {};
+  near_vt_ = {};
+  near_ee_ = {};
+  rest_near_built_ = false;
   x_built_.clear();
   bulk_list_ = {};
   all_tris_.clear();
@@ -181,16 +184,93 @@ double ShellGuard::cell_size(double radius) const {
   return std::max(radius, all_edges_.empty() ? radius : edge_sum / all_edges_.size());
 }
 
+void ShellGuard::build_rest_near() {
+  rest_near_built_ = true;
+  // All shells' rest limit vertices in one array, binned in cells of the largest near.
+  std::vector<Vec3d> rest;
+  double cell = 0;
+  for (const Mesh& m : meshes_) {
+    rest.insert(rest.end(), m.rest.begin(), m.rest.end());
+    cell = std::max(cell, m.near);
+  }
+  if (rest.empty() || !(cell > 0)) return;
+  TriangleGrid grid;
+  const auto local = [&](std::size_t g) {
+    return static_cast<int>(g - vertex_offset_[vert_shell_[g]]);
+  };
+  struct Part {
+    std::vector<int> item;
+    std::vector<std::size_t> count;
+  };
+  // Per item in chunks on the threads, each item's list sorted, joined in order.
+  const auto lists = [&](std::size_t n, std::size_t stamps, NearLists& out, const auto& visit) {
+    const std::uint32_t pass = Stamps::new_pass();
+    const auto parts =
+        chunk_parts(n, 512, serial_, Part(), [&](std::size_t b, std::size_t e, Part& part) {
+          Stamps stamp(stamps, pass);
+          for (std::size_t i = b; i < e; ++i) {
+            const std::size_t at = part.item.size();
+            visit(i, stamp, part.item);
+            std::sort(part.item.begin() + static_cast<std::ptrdiff_t>(at), part.item.end());
+            part.count.push_back(part.item.size() - at);
+          }
+        });
+    out.start.assign(1, 0);
+    out.item.clear();
+    for (const Part& part : parts) {
+      out.item.insert(out.item.end(), part.item.begin(), part.item.end());
+      for (std::size_t c : part.count) out.start.push_back(out.start.back() + c);
+    }
+  };
+  // The same tests, in the same order of arguments, as the list builds' rest test used
+  // to make per pair: distance_to_triangle(vertex, triangle), distance_of_segments(e, f).
+  grid.build(rest, all_tris_, cell, 0.0, serial_);
+  lists(rest.size(), all_tris_.size(), near_vt_,
+        [&](std::size_t p, Stamps& stamp, std::vector<int>& out) {
+          const int pi = static_cast<int>(p);
+          const std::size_t s = vert_shell_[p];
+          const Mesh& m = meshes_[s];
+          const Vec3d pad = Vec3d::Constant(m.near * (1 + 1e-6));
+          grid.for_each_in_box(rest[p] - pad, rest[p] + pad, [&](int t) {
+            if (!stamp.first(t, p)) return;
+            const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
+            if (T[0] == pi || T[1] == pi || T[2] == pi || vert_shell_[T[0]] != s) return;
+            const std::vector<Vec3d>& R = m.rest;
+            if (distance_to_triangle(R[local(p)], R[local(T[0])], R[local(T[1])], R[local(T[2])]) <
+                m.near)
+              out.push_back(t);
+          });
+        });
+  grid.build(rest, all_edges_, cell, 0.0, serial_);
+  lists(all_edges_.size(), all_edges_.size(), near_ee_,
+        [&](std::size_t e, Stamps& stamp, std::vector<int>& out) {
+          const Eigen::Vector3i& E = all_edges_[e];
+          const int ei = static_cast<int>(e);
+          const std::size_t s = vert_shell_[E[0]];
+          const Mesh& m = meshes_[s];
+          const Vec3d pad = Vec3d::Constant(m.near * (1 + 1e-6));
+          const Vec3d &p0 = rest[E[0]], &p1 = rest[E[1]];
+          grid.for_each_in_box(p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad, [&](int f) {
+            if (f <= ei || !stamp.first(f, e)) return;
+            const Eigen::Vector3i& F = all_edges_[static_cast<std::size_t>(f)];
+            if (F[0] == E[0] || F[0] == E[1] || F[1] == E[0] || F[1] == E[1]) return;
+            if (vert_shell_[F[0]] != s) return;
+            const std::vector<Vec3d>& R = m.rest;
+            if (distance_of_segments(R[local(E[0])], R[local(E[1])], R[local(F[0])],
+                                     R[local(F[1])]) < m.near)
+              out.push_back(f);
+          });
+        });
+}
+
 void ShellGuard::build_shell_candidates(double radius) {
   vt_cand_.clear();
   ee_cand_.clear();
+  if (!rest_near_built_) build_rest_near();
   const double cell = cell_size(radius);
   tri_grid_.build(pos_, all_tris_, cell, 0.0, serial_);
   edge_grid_.build(pos_, all_edges_, cell, 0.0, serial_);
   const Vec3d pad = Vec3d::Constant(radius);
-  const auto local = [&](std::size_t g) {
-    return static_cast<int>(g - vertex_offset_[vert_shell_[g]]);
-  };
   // Vertices, then edges, in chunks on the threads; each chunk keeps its own pairs, and
   // the chunks' pairs are joined in order (the same lists on any thread count).
   const std::size_t grain = 512;
@@ -214,6 +294,8 @@ void ShellGuard::build_shell_candidates(double radius) {
   chunked(pos_.size(), all_tris_.size(), vt_cand_,
           [&](std::size_t p, Stamps& stamp, std::vector<int>& cand) {
             const int pi = static_cast<int>(p);
+            // The triangles near p at rest are never taken: marked seen before the walk.
+            for (const int* t = near_vt_.begin(p); t != near_vt_.end(p); ++t) stamp.first(*t, p);
             tri_grid_.for_each_in_box(pos_[p] - pad, pos_[p] + pad, [&](int t) {
               if (!stamp.first(t, p)) return;
               const Eigen::Vector3i& T = all_tris_[static_cast<std::size_t>(t)];
@@ -222,13 +304,6 @@ void ShellGuard::build_shell_candidates(double radius) {
                 return;
               if (!(distance_to_triangle(pos_[p], pos_[T[0]], pos_[T[1]], pos_[T[2]]) < radius))
                 return;
-              const std::size_t s = vert_shell_[p];
-              if (s == vert_shell_[T[0]]) {
-                const std::vector<Vec3d>& R = meshes_[s].rest;
-                if (distance_to_triangle(R[local(p)], R[local(T[0])], R[local(T[1])],
-                                         R[local(T[2])]) < meshes_[s].near)
-                  return;
-              }
               cand.push_back(t);
             });
           });
@@ -237,19 +312,13 @@ void ShellGuard::build_shell_candidates(double radius) {
             const Eigen::Vector3i& E = all_edges_[e];
             const Vec3d &p0 = pos_[E[0]], &p1 = pos_[E[1]];
             const int ei = static_cast<int>(e);
+            for (const int* f = near_ee_.begin(e); f != near_ee_.end(e); ++f) stamp.first(*f, e);
             edge_grid_.for_each_in_box(p0.cwiseMin(p1) - pad, p0.cwiseMax(p1) + pad, [&](int f) {
               if (f <= ei || !stamp.first(f, e)) return;
               const Eigen::Vector3i& F = all_edges_[static_cast<std::size_t>(f)];
               if (F[0] == E[0] || F[0] == E[1] || F[1] == E[0] || F[1] == E[1]) return;
               if (boxes_apart<2, 2>({&p0, &p1}, {&pos_[F[0]], &pos_[F[1]]}, radius)) return;
               if (!(distance_of_segments(p0, p1, pos_[F[0]], pos_[F[1]]) < radius)) return;
-              const std::size_t s = vert_shell_[E[0]];
-              if (s == vert_shell_[F[0]]) {
-                const std::vector<Vec3d>& R = meshes_[s].rest;
-                if (distance_of_segments(R[local(E[0])], R[local(E[1])], R[local(F[0])],
-                                         R[local(F[1])]) < meshes_[s].near)
-                  return;
-              }
               cand.push_back(f);
             });
           });

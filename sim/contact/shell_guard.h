@@ -123,6 +123,8 @@ class ShellGuard {
   std::size_t impact_zones(double tol);
   /// Vertex-triangle and edge-edge pairs closer than radius at pos_ (sorted).
   void build_shell_candidates(double radius);
+  /// near_vt_, near_ee_ (once: the rest shapes are fixed).
+  void build_rest_near();
   /// Bulk particle-triangle pairs closer than radius (particles at x^n, sorted).
   void build_bulk_candidates(double radius, const GuardBulk& bulk, double dt);
   double cell_size(double radius) const;
@@ -190,7 +192,18 @@ class ShellGuard {
   std::vector<Vec3d> inv_mass_;  ///< per control point and component
   std::vector<Eigen::Vector3i> all_tris_;
   std::vector<Vec3d> edge_tri_pos_;
-  std::vector<Eigen::Vector3i> all_edges_;         ///< edges as degenerate triangles (a, b, b)
+  std::vector<Eigen::Vector3i> all_edges_;  ///< edges as degenerate triangles (a, b, b)
+  /// The pairs a list build never takes, found once: per limit vertex the triangles of
+  /// its shell within Mesh::near of it at rest (not its own), and per edge e the edges
+  /// f > e likewise (no shared vertex). Ascending, as offsets into one array each.
+  struct NearLists {
+    std::vector<std::size_t> start;
+    std::vector<int> item;
+    const int* begin(std::size_t i) const { return item.data() + start[i]; }
+    const int* end(std::size_t i) const { return item.data() + start[i + 1]; }
+  };
+  NearLists near_vt_, near_ee_;
+  bool rest_near_built_ = false;
   TriangleGrid tri_grid_, edge_grid_, bulk_grid_;  ///< used by the list builds only
   std::vector<Entry> entries_;
   std::vector<Pair> pairs_;

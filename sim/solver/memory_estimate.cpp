@@ -277,10 +277,13 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
   // The shell guard (sim/contact/shell_guard.h): its own limit mesh, edges (1.5 T), rest
   // positions; per pass the control and limit positions, velocities and inverse masses
   // (double); the triangle and edge grids of a list build, each feature in about 4 cells
-  // (a sorted (key, feature) pair plus the kept key and feature), and the stamps.
+  // (a sorted (key, feature) pair plus the kept key and feature), and the stamps; the
+  // pairs near at rest (measured on a regular sheet: 14 triangles per vertex, 12 edges
+  // per edge, as ints, and an offset per vertex and per edge).
   if (shot.shell_guard)
     t.guard_bytes += limit_mesh_bytes(V, T, S, false) + 1.5 * T * 8 + V * (24 + 8) + V * 4 * 24 +
-                     2.5 * T * 4 * (16 + 12) + 2.5 * T * 4;
+                     2.5 * T * 4 * (16 + 12) + 2.5 * T * 4 + V * (14 + 1.5 * 12) * 4 +
+                     (V + 1.5 * T) * 8;
   // Shell table, binned positions, pin holds and the force buffer of the grid shell.
   t.grid_points += V;
   t.shell_bytes += V * (2 + 4 + kVec3 + 1 + kVec3);

@@ -270,7 +270,9 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   reorder_particles();
   const double reorder_seconds = std::chrono::duration<double>(clock::now() - r0).count();
   fs.time = c_.time;
+  const auto m0 = clock::now();
   measure(fs);
+  const double measure_seconds = std::chrono::duration<double>(clock::now() - m0).count();
   fs.implicit = c_.scene.shot.integrator == Integrator::Implicit;
   fs.implicit_stats = c_.implicit_frame;
   if (fs.implicit) fs.implicit_stats.steps = fs.substeps;
@@ -279,6 +281,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   if (!stages_.empty()) {
     fs.stage_seconds.emplace_back("dt", dt_seconds);
     fs.stage_seconds.emplace_back("reorder", reorder_seconds);
+    fs.stage_seconds.emplace_back("frame_stats", measure_seconds);
     if (integrity_.active()) {
       fs.stage_seconds.emplace_back("integrity", integrity_seconds);
       fs.stage_seconds.emplace_back("integrity_frame", integrity_frame_seconds);

@@ -40,6 +40,13 @@ void StepContext::apply_walls() {
   parallel_for_each(
       grid.num_grid_blocks(), 16,
       [&](std::size_t b) {
+        // Blocks whose nodes all lie clear of the walls are left alone.
+        const Vec3i c = unpack_block(grid.gblock_key[b]) * kBlockSize;
+        bool clear = true;
+        for (int a = 0; a < 3; ++a)
+          clear =
+              clear && c[a] >= kWallCells && c[a] + kBlockSize - 1 <= domain_cells[a] - kWallCells;
+        if (clear) return;
         grid.for_each_massive_node(b, [&](GridNode& nd, const Vec3i& n) {
           for (int a = 0; a < 3; ++a) {
             if (n[a] < kWallCells && nd.v[a] < 0) nd.v[a] = 0;
