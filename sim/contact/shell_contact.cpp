@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
+#include <unordered_map>
 
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
@@ -40,22 +42,31 @@ ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& res
   volume.resize(ns);
   state.assign(ns, static_cast<std::uint8_t>(ContactState::Separated));
   C.assign(rest.size(), Mat3::Zero());
+  weight_row_.resize(ns);
+  // Distinct weight lists, by their bits.
+  std::unordered_map<std::string, std::uint32_t> rows;
+  std::vector<StencilWeight> w;
   BasisPoint bp;
   std::size_t p = 0;
   for (int f = 0; f < nf; ++f)
     for (std::size_t q = 0; q < rule.points.size(); ++q, ++p) {
       basis.evaluate(f, rule.points[q].x(), rule.points[q].y(), bp);
       Vec3d pos = Vec3d::Zero(), a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
+      w.clear();
       for (std::size_t k = 0; k < bp.ctrl.size(); ++k) {
         const Vec3d& r = rest[bp.ctrl[k]];
         pos += bp.N[k] * r;
         a1 += bp.N1[k] * r;
         a2 += bp.N2[k] * r;
         idx.push_back(static_cast<std::uint32_t>(bp.ctrl[k]));
-        N.push_back(static_cast<Real>(bp.N[k]));
-        N1.push_back(static_cast<Real>(bp.N1[k]));
-        N2.push_back(static_cast<Real>(bp.N2[k]));
+        w.push_back(
+            {static_cast<Real>(bp.N[k]), static_cast<Real>(bp.N1[k]), static_cast<Real>(bp.N2[k])});
       }
+      std::string key(reinterpret_cast<const char*>(w.data()), w.size() * sizeof(StencilWeight));
+      const auto [at, added] =
+          rows.emplace(std::move(key), static_cast<std::uint32_t>(weight_table_.size()));
+      if (added) weight_table_.insert(weight_table_.end(), w.begin(), w.end());
+      weight_row_[p] = at->second;
       off.push_back(static_cast<std::uint32_t>(idx.size()));
       const Vec3d n = a1.cross(a2);
       const double jac = n.norm();
@@ -73,13 +84,15 @@ ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& res
   tN1.resize(idx.size());
   tN2.resize(idx.size());
   std::vector<std::uint32_t> cur(toff.begin(), toff.end() - 1);
-  for (std::size_t s = 0; s < ns; ++s)
+  for (std::size_t s = 0; s < ns; ++s) {
+    const StencilWeight* ws = weights(s);
     for (std::uint32_t k = off[s]; k < off[s + 1]; ++k) {
       const std::uint32_t at = cur[idx[k]]++;
       tsite[at] = static_cast<std::uint32_t>(s);
-      tN1[at] = N1[k];
-      tN2[at] = N2[k];
+      tN1[at] = ws[k - off[s]].N1;
+      tN2[at] = ws[k - off[s]].N2;
     }
+  }
 }
 
 void ShellContact::tangents(const Vec3* ctrl, std::size_t p, Vec3& a1, Vec3& a2) const {
@@ -93,13 +106,14 @@ void ShellContact::position_and_tangents(const Vec3* ctrl, std::size_t p, Vec3& 
   // keeps float precision far from the origin. Each sum on a 4-vector (x, y, z, 0).
   R4 ref, d = {}, t1 = {}, t2 = {};
   load3(ctrl[idx[off[p]]], ref);
+  const StencilWeight* w = weights(p);
   for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) {
     R4 c;
     load3(ctrl[idx[k]], c);
     const R4 dk = c - ref;
-    d += N[k] * dk;
-    t1 += N1[k] * dk;
-    t2 += N2[k] * dk;
+    d += w[k - off[p]].N * dk;
+    t1 += w[k - off[p]].N1 * dk;
+    t2 += w[k - off[p]].N2 * dk;
   }
   xp = Vec3(ref[0] + d[0], ref[1] + d[1], ref[2] + d[2]);
   a1 = Vec3(t1[0], t1[1], t1[2]);
@@ -109,7 +123,8 @@ void ShellContact::position_and_tangents(const Vec3* ctrl, std::size_t p, Vec3& 
 Vec3 ShellContact::position(const Vec3* ctrl, std::size_t p) const {
   const Vec3 ref = ctrl[idx[off[p]]];
   Vec3 d = Vec3::Zero();
-  for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) d += N[k] * (ctrl[idx[k]] - ref);
+  const StencilWeight* w = weights(p);
+  for (std::uint32_t k = off[p]; k < off[p + 1]; ++k) d += w[k - off[p]].N * (ctrl[idx[k]] - ref);
   return ref + d;
 }
 

@@ -64,9 +64,16 @@ class ShellContact {
   // Per control point.
   std::vector<Mat3> C;  ///< APIC affine velocity matrix [1/s]
 
-  // Site stencils (CSR): control points k in [off[p], off[p+1]).
+  // Site stencils (CSR): control points idx[k], k in [off[p], off[p+1]), with the basis
+  // values weights(p)[k - off[p]].
   std::vector<std::uint32_t> off, idx;
-  std::vector<Real> N, N1, N2;
+  struct StencilWeight {
+    Real N, N1, N2;  ///< N_k, dN_k/dxi1, dN_k/dxi2 at the site
+  };
+  /// Site p's stencil weights, one per control point. Sites with the same weights (every
+  /// site at one place of a regular patch) share one table, so the stencil walks stream
+  /// the control point indices only.
+  const StencilWeight* weights(std::size_t p) const { return &weight_table_[weight_row_[p]]; }
 
  private:
   /// The friction return mapping's sums over sites.
@@ -102,6 +109,9 @@ class ShellContact {
   // [toff[j], toff[j+1]) name a site and its dN/dxi.
   std::vector<std::uint32_t> toff, tsite;
   std::vector<Real> tN1, tN2;
+  // The distinct stencil weights (weights()): site p's from weight_table_[weight_row_[p]].
+  std::vector<StencilWeight> weight_table_;
+  std::vector<std::uint32_t> weight_row_;
   std::vector<Vec3> G1_, G2_;
 };
 

@@ -40,10 +40,11 @@ void site_tangents(const ShellContact& c, const std::vector<Vec3d>& X, std::size
   const Vec3d ref = X[c.idx[c.off[p]]];
   a1.setZero();
   a2.setZero();
+  const ShellContact::StencilWeight* w = c.weights(p);
   for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
     const Vec3d d = X[c.idx[k]] - ref;
-    a1 += static_cast<double>(c.N1[k]) * d;
-    a2 += static_cast<double>(c.N2[k]) * d;
+    a1 += static_cast<double>(w[k - c.off[p]].N1) * d;
+    a2 += static_cast<double>(w[k - c.off[p]].N2) * d;
   }
 }
 
@@ -63,9 +64,10 @@ double site_energy(const ShellContact& c, const std::vector<Vec3d>& X, std::size
 /// points' entries of out (dN_k/dxi_beta times them).
 void scatter_tangential(const ShellContact& c, std::size_t p, const Mat3d& G, double sign,
                         std::vector<Vec3d>& out) {
+  const ShellContact::StencilWeight* w = c.weights(p);
   for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k)
-    out[c.idx[k]] +=
-        sign * (static_cast<double>(c.N1[k]) * G.col(0) + static_cast<double>(c.N2[k]) * G.col(1));
+    out[c.idx[k]] += sign * (static_cast<double>(w[k - c.off[p]].N1) * G.col(0) +
+                             static_cast<double>(w[k - c.off[p]].N2) * G.col(1));
 }
 
 Vec3i corner_of(const SparseGrid& grid, std::size_t b) {
@@ -378,9 +380,10 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) tk.emplace_back(pr + i, pr + j, H(6 + i, 6 + j));
       // d^2 psi / dX_k da3E = sum_beta dN_k/dxi_beta d^2 psi / da_beta da3E.
+      const ShellContact::StencilWeight* w = c.weights(p);
       for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
-        const Mat3d B = static_cast<double>(c.N1[k]) * H.block<3, 3>(0, 6) +
-                        static_cast<double>(c.N2[k]) * H.block<3, 3>(3, 6);
+        const Mat3d B = static_cast<double>(w[k - c.off[p]].N1) * H.block<3, 3>(0, 6) +
+                        static_cast<double>(w[k - c.off[p]].N2) * H.block<3, 3>(3, 6);
         for (int i = 0; i < 3; ++i) {
           const int d = dof_of[s][3 * c.idx[k] + i];
           if (d < 0) continue;

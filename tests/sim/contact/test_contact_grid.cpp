@@ -117,9 +117,10 @@ struct Rig {
     const ContactParams& p = contact->params();
     for (std::size_t s = 0; s < contact->num_sites(); ++s) {
       Vec3d a1 = Vec3d::Zero(), a2 = Vec3d::Zero();
+      const ShellContact::StencilWeight* ws = contact->weights(s);
       for (std::uint32_t k = contact->off[s]; k < contact->off[s + 1]; ++k) {
-        a1 += static_cast<double>(contact->N1[k]) * x[contact->idx[k]];
-        a2 += static_cast<double>(contact->N2[k]) * x[contact->idx[k]];
+        a1 += static_cast<double>(ws[k - contact->off[s]].N1) * x[contact->idx[k]];
+        a2 += static_cast<double>(ws[k - contact->off[s]].N2) * x[contact->idx[k]];
       }
       const SiteStencil st = site_stencil(grid, contact->x[s], mass);
       Vec3d a3 = contact->a3e[s].cast<double>();
