@@ -15,7 +15,8 @@ SimdLevel detect() {
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
       __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl"))
     return SimdLevel::Avx512;
-  if (__builtin_cpu_supports("avx2")) return SimdLevel::Avx2;
+  // (Every CPU with AVX2 has FMA as well; the Kirchhoff-Love kernel's AVX2 instance uses it.)
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return SimdLevel::Avx2;
   return SimdLevel::Sse;
 }
 

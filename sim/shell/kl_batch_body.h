@@ -14,9 +14,13 @@
 // (the small-x series of atanh(x)/x, the stretch term past the limit) are taken in every
 // lane and selected.
 //
-// Differences to the scalar code, all rounding: log is vlog (within 2 ulp), atanh(x) is
-// log((1 + x) / (1 - x)) / 2, and past the stretch limit the principal stretches come from
-// the eigenvalues of C (s_1^2 = tr/2 + h, s_2^2 = det / s_1^2) instead of exp(L +- D)/4.
+// The sums of control points times coefficients (a_alpha, a_alphabeta; each control
+// point's share of the forces) are fused multiply-adds (kl_lanes.h madd: the instruction
+// on AVX2 and AVX-512, the same bits computed in double on SSE).
+//
+// Differences to the scalar code, all rounding: the fused multiply-adds, log is vlog (within 2
+// ulp), atanh(x) is log((1 + x) / (1 - x)) / 2, and past the stretch limit the principal stretches
+// come from the eigenvalues of C (s_1^2 = tr/2 + h, s_2^2 = det / s_1^2) instead of exp(L +- D)/4.
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
@@ -31,6 +35,8 @@ namespace {
 
 using lanes::any;
 using lanes::join;
+using lanes::madd;
+using lanes::madd4;
 using lanes::part;
 using lanes::splat;
 using lanes::V3;
@@ -60,6 +66,30 @@ template <class F>
   for (int i = 0; i < 4; ++i) out[i] = join<F>(c[i]);
 }
 
+/// layer_metric (laminate_energy.h) in lanes, with fused multiply-adds.
+template <class F>
+[[gnu::always_inline]] inline void metric_lanes(const F (&Bp)[4], F m11, F m12, F m22, F& c11,
+                                                F& c12, F& c22) {
+  const F b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
+  const F mb0x = madd(m12, b10, m11 * b00), mb0y = madd(m22, b10, m12 * b00);
+  const F mb1x = madd(m12, b11, m11 * b01), mb1y = madd(m22, b11, m12 * b01);
+  c11 = madd(b10, mb0y, b00 * mb0x);
+  c12 = madd(b10, mb1y, b00 * mb1x);
+  c22 = madd(b11, mb1y, b01 * mb1x);
+}
+
+/// metric_adjoint (laminate_energy.h) in lanes, with fused multiply-adds.
+template <class F>
+[[gnu::always_inline]] inline void metric_adjoint_lanes(const F (&Bp)[4], F s11, F s12, F s22,
+                                                        F (&S)[3]) {
+  const F b00 = Bp[0], b01 = Bp[1], b10 = Bp[2], b11 = Bp[3];
+  const F r00 = madd(b01, s12, b00 * s11), r01 = madd(b01, s22, b00 * s12);
+  const F r10 = madd(b11, s12, b10 * s11), r11 = madd(b11, s22, b10 * s12);
+  S[0] = madd(r01, b01, r00 * b00);
+  S[1] = madd(r01, b11, r00 * b10);
+  S[2] = madd(r11, b11, r10 * b10);
+}
+
 /// layer_psi (laminate_energy.h) in lanes: psi, and dpsi/dM in S.
 template <class F>
 [[gnu::always_inline]] inline F layer_psi_lanes(const BatchData& d, const F (&Bp)[4], F m11, F m12,
@@ -67,28 +97,28 @@ template <class F>
   using I = decltype(m11 < m11);
   const float mu = d.mu, lambda = d.lambda;
   F c11, c12, c22;
-  layer_metric(Bp, m11, m12, m22, c11, c12, c22);
+  metric_lanes(Bp, m11, m12, m22, c11, c12, c22);
   const F tr = c11 + c22;
-  const F det = c11 * c22 - c12 * c12;
+  const F det = madd(c11, c22, -(c12 * c12));
   const F hd = splat<F>(0.5f) * (c11 - c22);
-  const F h = vsqrt(hd * hd + c12 * c12);
+  const F h = vsqrt(madd(hd, hd, c12 * c12));
   const F x = splat<F>(2.0f) * h / tr;
   // atanh(x) / x: the series below 1e-2, else log((1 + x) / (1 - x)) / (2 x).
   const F x2 = x * x;
-  const F series =
-      splat<F>(1.0f) +
-      x2 * (splat<F>(1.0f / 3.0f) + x2 * (splat<F>(1.0f / 5.0f) + x2 * splat<F>(1.0f / 7.0f)));
+  const F series = madd(
+      x2, madd(x2, madd(x2, splat<F>(1.0f / 7.0f), splat<F>(1.0f / 5.0f)), splat<F>(1.0f / 3.0f)),
+      splat<F>(1.0f));
   const F full = splat<F>(0.5f) * vlog((splat<F>(1.0f) + x) / (splat<F>(1.0f) - x)) / x;
   const F q = x < splat<F>(1e-2f) ? series : full;
   const F L = vlog(det);
   const F D = splat<F>(2.0f) * x * q;
-  F psi = splat<F>(0.125f * mu) * (L * L + D * D) + splat<F>(0.125f * lambda) * (L * L);
+  F psi = madd(splat<F>(0.125f * mu), madd(L, L, D * D), splat<F>(0.125f * lambda) * (L * L));
   // dpsi/dC = k adj(C) + d I
   const F beta = splat<F>(2.0f) * q / tr;
   const F alpha = splat<F>(0.5f) * (L - beta * tr);
-  const F kk = (splat<F>(0.5f * mu) * alpha + splat<F>(0.25f * lambda) * L) / det;
+  const F kk = madd(splat<F>(0.5f * mu), alpha, splat<F>(0.25f * lambda) * L) / det;
   const F dd = splat<F>(0.5f * mu) * beta;
-  F s11 = kk * c22 + dd, s12 = splat<F>(0.0f) - kk * c12, s22 = kk * c11 + dd;
+  F s11 = madd(kk, c22, dd), s12 = splat<F>(0.0f) - kk * c12, s22 = madd(kk, c11, dd);
   // The stretch term where log s_1 = (L + D) / 4 passes log s_l.
   const I beyond = splat<F>(0.25f) * (L + D) > splat<F>(d.log_limit);
   if (any(beyond)) {
@@ -114,7 +144,7 @@ template <class F>
     s12 = beyond ? s12 + sc * c12 : s12;
     s22 = beyond ? s22 + (si + sc * c22) : s22;
   }
-  metric_adjoint(Bp, s11, s12, s22, S);
+  metric_adjoint_lanes(Bp, s11, s12, s22, S);
   return psi;
 }
 
@@ -165,8 +195,8 @@ template <class F>
   const V3<F> a3 = inv_l * nrm;
   const V3<F> t1 = inv_l * (cross(a11, a2) + cross(a1, a12));
   const V3<F> t2 = inv_l * (cross(a12, a2) + cross(a1, a22));
-  const V3<F> v1 = t1 - dot(a3, t1) * a3;
-  const V3<F> v2 = t2 - dot(a3, t2) * a3;
+  const V3<F> v1 = madd(-dot(a3, t1), a3, t1);
+  const V3<F> v2 = madd(-dot(a3, t2), a3, t2);
   F area;
   if (lanes)
     area = load_lanes<F>(lanes->area);
@@ -177,7 +207,7 @@ template <class F>
   F energy = splat<F>(0.0f);
   for (int l = 0; l < nl; ++l) {
     const F xi3 = splat<F>(d.layer_xi3[l]);
-    const V3<F> g1 = a1 + xi3 * v1, g2 = a2 + xi3 * v2;
+    const V3<F> g1 = madd(xi3, v1, a1), g2 = madd(xi3, v2, a2);
     const F m11 = dot(g1, g1), m12 = dot(g1, g2), m22 = dot(g2, g2);
     __m128 rows[W];
     F Bp[4];
@@ -200,23 +230,27 @@ template <class F>
     }
     const F V = area * splat<F>(d.layer_w[l]);
     F S[3];
-    energy = energy + V * layer_psi_lanes<F>(d, Bp, m11, m12, m22, S);
+    energy = madd(V, layer_psi_lanes<F>(d, Bp, m11, m12, m22, S), energy);
     if (adjoints) {
       const F s = splat<F>(2.0f) * V;
-      const V3<F> dg1 = s * (S[0] * g1 + S[1] * g2);
-      const V3<F> dg2 = s * (S[1] * g1 + S[2] * g2);
+      const V3<F> dg1 = s * madd(S[1], g2, S[0] * g1);
+      const V3<F> dg2 = s * madd(S[2], g2, S[1] * g1);
       Ga1 = Ga1 + dg1;
       Ga2 = Ga2 + dg2;
-      Gv1 = Gv1 + xi3 * dg1;
-      Gv2 = Gv2 + xi3 * dg2;
+      Gv1 = madd(xi3, dg1, Gv1);
+      Gv2 = madd(xi3, dg2, Gv2);
     }
   }
   if (!adjoints) return energy;
   // Backpropagation through v_a = (I - a3 a3^T) m_a / l (eval_kinematics).
-  const V3<F> PG1 = Gv1 - dot(a3, Gv1) * a3, PG2 = Gv2 - dot(a3, Gv2) * a3;
+  const V3<F> PG1 = madd(-dot(a3, Gv1), a3, Gv1), PG2 = madd(-dot(a3, Gv2), a3, Gv2);
   const V3<F> cm1 = inv_l * PG1, cm2 = inv_l * PG2;
-  const V3<F> sum = dot(a3, t1) * PG1 + dot(a3, Gv1) * v1 + dot(Gv1, v1) * a3 + dot(a3, t2) * PG2 +
-                    dot(a3, Gv2) * v2 + dot(Gv2, v2) * a3;
+  V3<F> sum = dot(a3, t1) * PG1;
+  sum = madd(dot(a3, Gv1), v1, sum);
+  sum = madd(dot(Gv1, v1), a3, sum);
+  sum = madd(dot(a3, t2), PG2, sum);
+  sum = madd(dot(a3, Gv2), v2, sum);
+  sum = madd(dot(Gv2, v2), a3, sum);
   const V3<F> cn = (splat<F>(0.0f) - inv_l) * sum;
   G[0] = Ga1 + (cross(a12, cm1) + cross(a22, cm2) + cross(a2, cn));
   G[1] = Ga2 + (cross(cm1, a11) + cross(cm2, a12) + cross(cn, a1));
@@ -266,8 +300,7 @@ template <int W>
       for (std::size_t e = begin[q] + 1; e < begin[q + 1]; ++e) {
         const __m128 dx = _mm_sub_ps(load3(x + 3 * std::size_t(ctrl[e])), x0);
         const float* c = &coef[5 * e];
-        for (int i = 0; i < 5; ++i)
-          acc[i][j] = _mm_add_ps(acc[i][j], _mm_mul_ps(_mm_set1_ps(c[i]), dx));
+        for (int i = 0; i < 5; ++i) acc[i][j] = madd4(_mm_set1_ps(c[i]), dx, acc[i][j]);
       }
     }
     V3<F> av[5];
@@ -288,12 +321,8 @@ template <int W>
     for (int j = 0; j < cnt; ++j)
       for (std::size_t e = begin[qs[j]], e1 = begin[qs[j] + 1]; e < e1; ++e) {
         const float* c = &coef[5 * e];
-        const __m128 share =
-            _mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(c[0]), G[0][j]),
-                                                        _mm_mul_ps(_mm_set1_ps(c[1]), G[1][j])),
-                                             _mm_mul_ps(_mm_set1_ps(c[2]), G[2][j])),
-                                  _mm_mul_ps(_mm_set1_ps(c[3]), G[3][j])),
-                       _mm_mul_ps(_mm_set1_ps(c[4]), G[4][j]));
+        __m128 share = _mm_mul_ps(_mm_set1_ps(c[0]), G[0][j]);
+        for (int i = 1; i < 5; ++i) share = madd4(_mm_set1_ps(c[i]), G[i][j], share);
         _mm_storeu_ps(&fe[4 * std::size_t(slot[e])], share);
       }
   }
@@ -340,7 +369,7 @@ template <int W>
       V3<F> av[5] = {zero, zero, zero, zero, zero};
       for (int c = 1; c < m; ++c) {
         const float* ck = C + 5 * (std::size_t(k) * m + c);
-        for (int a = 0; a < 5; ++a) av[a] = av[a] + splat<F>(ck[a]) * dX[c];
+        for (int a = 0; a < 5; ++a) av[a] = madd(splat<F>(ck[a]), dX[c], av[a]);
       }
       std::size_t qs[W];
       for (int j = 0; j < W; ++j) qs[j] = std::size_t(g[j]) * P + k;
@@ -357,15 +386,13 @@ template <int W>
     }
     if (fe) {
       // Per control point c: sum over the points k of c0 Ga1 + c1 Ga2 + c2 G11 + c3 G12 +
-      // c4 G22, then one SSE store per lane.
+      // c4 G22 (one fused multiply-add per term), then one SSE store per lane.
       for (int c = 0; c < m; ++c) {
-        const auto share = [&](int k) {
+        V3<F> s = splat<F>(C[5 * std::size_t(c)]) * G[0][0];
+        for (int k = 0; k < P; ++k) {
           const float* ck = C + 5 * (std::size_t(k) * m + c);
-          return splat<F>(ck[0]) * G[k][0] + splat<F>(ck[1]) * G[k][1] + splat<F>(ck[2]) * G[k][2] +
-                 splat<F>(ck[3]) * G[k][3] + splat<F>(ck[4]) * G[k][4];
-        };
-        V3<F> s = share(0);
-        for (int k = 1; k < P; ++k) s = s + share(k);
+          for (int a = k == 0 ? 1 : 0; a < 5; ++a) s = madd(splat<F>(ck[a]), G[k][a], s);
+        }
         for (int q = 0; q < W / 4; ++q) {
           __m128 r0 = part(s.x, q), r1 = part(s.y, q), r2 = part(s.z, q), r3 = _mm_setzero_ps();
           _MM_TRANSPOSE4_PS(r0, r1, r2, r3);

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -63,6 +64,61 @@ std::vector<Eigen::Vector3f> plastic_and_bent(KirchhoffLoveShellT<float>& shf,
 }
 
 }  // namespace
+
+TEST_CASE("the four-lane fused multiply-add has the bits of a single rounding", "[kl]") {
+  // madd4 without the FMA instruction (this file is compiled without it) against fmaf,
+  // which rounds once. The naive double sum fails on the second kind of case below.
+#ifdef __FMA__
+  WARN("compiled with FMA: madd4 is the instruction here, not the double emulation");
+#endif
+  const auto madd = [](float a, float b, float c) {
+    float out[4];
+    _mm_storeu_ps(out,
+                  kl::lanes::madd4(_mm_set_ps(0.0f, 0.0f, c, a), _mm_set_ps(0.0f, 1.0f, 0.0f, b),
+                                   _mm_set_ps(c, 0.0f, 0.0f, c)));
+    return out[0];
+  };
+  const auto same = [](float x, float y) {
+    std::uint32_t bx, by;
+    std::memcpy(&bx, &x, 4);
+    std::memcpy(&by, &y, 4);
+    return bx == by || (std::isnan(x) && std::isnan(y));
+  };
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> mant(-2.0f, 2.0f);
+  std::uniform_int_distribution<int> expo(-70, 70);
+  long wrong = 0, naive_wrong = 0;
+  for (int i = 0; i < 300000; ++i) {
+    const float a = std::ldexp(mant(rng), expo(rng)), b = std::ldexp(mant(rng), expo(rng));
+    // c at random, or near -a b (cancellation), or a tiny nudge off a halfway product.
+    float c = std::ldexp(mant(rng), expo(rng));
+    if (i % 3 == 1) c = -static_cast<float>(static_cast<double>(a) * b) * (1 + 1e-6f * mant(rng));
+    wrong += !same(madd(a, b, c), std::fmaf(a, b, c));
+  }
+  // Products halfway between floats, broken by a c below double precision: the sum rounds
+  // to the tie in double and then to even in float, where fmaf rounds away from it.
+  for (int k = 1; k < 12; ++k) {
+    const float a = 1.0f + std::ldexp(1.0f, -k), b = 1.0f + std::ldexp(1.0f, -24 + k);
+    for (const float c : {std::ldexp(1.0f, -60), -std::ldexp(1.0f, -60), 0.0f}) {
+      const float want = std::fmaf(a, b, c);
+      wrong += !same(madd(a, b, c), want);
+      naive_wrong +=
+          static_cast<float>(static_cast<double>(a) * b + static_cast<double>(c)) != want;
+    }
+  }
+  CHECK(wrong == 0);
+  CHECK(naive_wrong > 0);  // the cases do test the rounding to odd
+  // Signs of zero, overflow, subnormal results, infinities and NaN.
+  const float inf = std::numeric_limits<float>::infinity(), big = 3e38f, tiny = 1e-30f;
+  const float cases[][3] = {{0.0f, 1.0f, -0.0f},   {-0.0f, 1.0f, -0.0f},       {1.0f, -1.0f, 1.0f},
+                            {big, 10.0f, 0.0f},    {big, 10.0f, -big},         {tiny, tiny, 0.0f},
+                            {tiny, tiny, -1e-45f}, {inf, 1.0f, 1.0f},          {inf, 0.0f, 1.0f},
+                            {1.0f, 1.0f, -inf},    {std::nanf(""), 1.0f, 1.0f}};
+  for (const auto& t : cases) {
+    INFO(t[0] << " * " << t[1] << " + " << t[2]);
+    CHECK(same(madd(t[0], t[1], t[2]), std::fmaf(t[0], t[1], t[2])));
+  }
+}
 
 TEST_CASE("the lane logarithm is within 2 ulp of std::log, with its special values", "[kl]") {
   std::mt19937 rng(5);
