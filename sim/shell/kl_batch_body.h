@@ -102,20 +102,24 @@ template <class F>
   const F det = madd(c11, c22, -(c12 * c12));
   const F hd = splat<F>(0.5f) * (c11 - c22);
   const F h = vsqrt(madd(hd, hd, c12 * c12));
-  const F x = splat<F>(2.0f) * h / tr;
-  // atanh(x) / x: the series below 1e-2, else log((1 + x) / (1 - x)) / (2 x).
+  // x = 2 h / tr; q = atanh(x) / x; D = 2 x q = log(c1 / c2); beta = 2 q / tr = D / (2 h).
+  // Below x = 1e-2 q is the series 1 + x^2/3 + x^4/5 + x^6/7; above, D is
+  // log((tr + 2 h) / (tr - 2 h)) (= log((1 + x) / (1 - x)), without rounding 1 +- x).
+  const F inv_tr = splat<F>(1.0f) / tr;
+  const F h2 = splat<F>(2.0f) * h;
+  const F x = h2 * inv_tr;
   const F x2 = x * x;
   const F series = madd(
       x2, madd(x2, madd(x2, splat<F>(1.0f / 7.0f), splat<F>(1.0f / 5.0f)), splat<F>(1.0f / 3.0f)),
       splat<F>(1.0f));
-  const F full = splat<F>(0.5f) * vlog((splat<F>(1.0f) + x) / (splat<F>(1.0f) - x)) / x;
-  const F q = x < splat<F>(1e-2f) ? series : full;
+  const I small = x < splat<F>(1e-2f);
+  const F D_full = vlog((tr + h2) / (tr - h2));
+  const F D = small ? splat<F>(2.0f) * x * series : D_full;
   const F L = vlog(det);
-  const F D = splat<F>(2.0f) * x * q;
   F psi = madd(splat<F>(0.125f * mu), madd(L, L, D * D), splat<F>(0.125f * lambda) * (L * L));
   // dpsi/dC = k adj(C) + d I
-  const F beta = splat<F>(2.0f) * q / tr;
-  const F alpha = splat<F>(0.5f) * (L - beta * tr);
+  const F beta = small ? splat<F>(2.0f) * series * inv_tr : D_full / h2;
+  const F alpha = splat<F>(0.5f) * madd(-beta, tr, L);
   const F kk = madd(splat<F>(0.5f * mu), alpha, splat<F>(0.25f * lambda) * L) / det;
   const F dd = splat<F>(0.5f * mu) * beta;
   F s11 = madd(kk, c22, dd), s12 = splat<F>(0.0f) - kk * c12, s22 = madd(kk, c11, dd);
