@@ -156,6 +156,7 @@ SHELLMPM_BLOCKS_INLINE void scatter_heights(HeightsPadNode* pad, const Quadratic
 /// into the grid's (FoldHeights::ready).
 SHELLMPM_BLOCKS_INLINE void merge_heights(const SparseGrid& grid, std::size_t b,
                                           const HeightsPadNode* pad, FoldHeights& heights) {
+  bool spread = false;
   grid.for_each_pad_node(b, [&](int gb, int bn, int pn) {
     const HeightsPadNode& p = pad[pn];
     if (p.m == 0 && p.hmin == std::numeric_limits<Real>::max()) return;  // not reached
@@ -168,7 +169,9 @@ SHELLMPM_BLOCKS_INLINE void merge_heights(const SparseGrid& grid, std::size_t b,
     d.m += p.m;
     d.hmin = std::min(d.hmin, p.hmin);
     d.hmax = std::max(d.hmax, -p.nhmax);
+    spread = spread || heights_spread(d);
   });
+  if (spread) heights.spread.store(true, std::memory_order_relaxed);
 }
 
 /// Prefetches what the control points' P2G (with heights where not null: the normal) and

@@ -133,23 +133,12 @@ FoldHeights* ShellFields::begin_p2g(const SparseGrid& combined,
   heights_.align = kAlign;
   heights_.blocks.resize(combined.num_grid_blocks());  // set where points reach them
   heights_.ready.assign(combined.num_grid_blocks(), 0);
+  heights_.spread.store(false);
   return &heights_;
 }
 
-bool ShellFields::any_spread(bool serial) const {
-  std::atomic<bool> found{false};
-  parallel_for_each(
-      heights_.blocks.size(), 64,
-      [&](std::size_t g) {
-        if (!heights_.ready[g] || found.load(std::memory_order_relaxed)) return;
-        for (const NodeHeights& d : heights_.blocks[g])
-          if (spreads(d)) {
-            found.store(true, std::memory_order_relaxed);
-            return;
-          }
-      },
-      serial);
-  return found.load();
+bool ShellFields::any_spread() const {
+  return heights_.spread.load();
 }
 
 void ShellFields::shell_p2g(Field& F, const GridShell& gs, const SparseGrid& combined, Real dt,
@@ -159,7 +148,7 @@ void ShellFields::shell_p2g(Field& F, const GridShell& gs, const SparseGrid& com
     // The combined P2G summed the heights (begin_p2g, shell_p2g_block). Where none spreads
     // the shell has no fold: one body at every node, the field stays empty.
     F.folds.clear();
-    if (!any_spread(serial)) {
+    if (!any_spread()) {
       F.fold.clear();
       return;
     }

@@ -214,8 +214,8 @@ class ShellFields {
   template <class AddFn>
   void scatter_shares(Field& F, const GridShell& gs, Real dt, bool heights, bool serial, AddFn add);
   /// heights_only_: whether a node of the combined P2G's heights spreads (a fold).
-  bool any_spread(bool serial) const;
-  /// A node whose heights spread by kMinRange cells or more (shell_folds.cpp): two layers.
+  bool any_spread() const;
+  /// A node whose heights spread by kFoldMinRange cells or more (shell_folds.cpp): two layers.
   static bool spreads(const NodeHeights& d);
   /// Momentum to velocity, first moment to centroid offset.
   static void normalise(Node& d);

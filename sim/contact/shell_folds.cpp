@@ -9,7 +9,7 @@
 // layer gives one height at every point, two layers give two, whatever the layers'
 // orientation (the normals are turned to a fixed direction first, so a fold whose normals
 // face each other counts like stacked turns). P2G keeps each node's least and greatest
-// height; where they differ by kMinRange cells or more, the points are split at the
+// height; where they differ by kFoldMinRange cells or more, the points are split at the
 // midpoint into two classes, and each becomes a body of its own for Bardenhagen's rule.
 // A single layer curved to a radius under about two cells also spans that range and is
 // split between its inner and outer part: harmless, the parts are held together by the
@@ -23,15 +23,9 @@
 #include "sim/mpm/apic_stencil.h"
 
 namespace shellmpm {
-namespace {
-/// Least spread of a node's heights over the tangent planes, in cells, for a split: two
-/// layers resting on each other lie 1-2 cells apart; one flat layer spreads by round-off,
-/// one bent to a radius of R cells by about 2.25 / R.
-constexpr Real kMinRange = Real(1.0);
-}  // namespace
 
 bool ShellFields::spreads(const NodeHeights& d) {
-  return d.m > 0 && d.hmax - d.hmin >= kMinRange;
+  return heights_spread(d);
 }
 
 void ShellFields::mark_split_nodes(Field& F, bool heights_only) {

@@ -76,6 +76,14 @@ struct NodeHeights {
 constexpr NodeHeights kNoHeights{Real(0), std::numeric_limits<Real>::max(),
                                  std::numeric_limits<Real>::lowest()};
 
+/// A node's heights spread by this many cells or more: the shell folds there (two layers;
+/// sim/contact/shell_folds.cpp). Two layers resting on each other lie 1-2 cells apart; one
+/// flat layer spreads by round-off, one bent to a radius of R cells by about 2.25 / R.
+constexpr Real kFoldMinRange = Real(1.0);
+inline bool heights_spread(const NodeHeights& d) {
+  return d.m > 0 && d.hmax - d.hmin >= kFoldMinRange;
+}
+
 /// The fold heights of a lone shell's control points, summed in the combined P2G
 /// (ShellFields::begin_p2g): per combined grid block, a node's sum of w m and range of
 /// fold_height over the points with w > 0. A block's nodes are set (from kNoHeights)
@@ -85,6 +93,10 @@ struct FoldHeights {
   Vec3 align;                    ///< normals are turned to this direction's side
   std::vector<std::array<NodeHeights, kBlockNodes>> blocks;
   std::vector<std::uint8_t> ready;
+  /// Whether some node's heights spread (heights_spread), set as the particle blocks'
+  /// heights are merged: a node's mass and range only grow, so this is the same as testing
+  /// every node after the P2G.
+  std::atomic<bool> spread{false};
   const std::array<NodeHeights, kBlockNodes>& block(std::size_t g) const {
     static const std::array<NodeHeights, kBlockNodes> none = [] {
       std::array<NodeHeights, kBlockNodes> a;
