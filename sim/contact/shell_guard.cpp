@@ -476,7 +476,7 @@ double ShellGuard::point_bounds(const std::vector<GridShell>& shells,
   // build (where it was built for these points): reads only, every step.
   const std::size_t np = point_offset_.back();
   struct Bounds {
-    double vmax = 0;
+    double vmax = 0;  // squared, until the end
     Vec3d lo = Vec3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   };
   const bool since_build = x_built_.size() == np;
@@ -487,7 +487,9 @@ double ShellGuard::point_bounds(const std::vector<GridShell>& shells,
         sh.size(), kPointGrain, serial_, Bounds(), [&](std::size_t b, std::size_t e, Bounds& m) {
           for (std::size_t j = b; j < e; ++j) {
             const Vec3d x0 = to_d(start[s][j]);
-            m.vmax = std::max(m.vmax, ((to_d(sh.x[j]) - x0) / dt).norm());
+            // The squared speed: its square root once at the end is the same number
+            // (the square root is monotone and correctly rounded).
+            m.vmax = std::max(m.vmax, ((to_d(sh.x[j]) - x0) / dt).squaredNorm());
             if (since_build) {
               const Vec3d d = x0 - x_built_[point_offset_[s] + j];
               m.lo = m.lo.cwiseMin(d);
@@ -507,7 +509,7 @@ double ShellGuard::point_bounds(const std::vector<GridShell>& shells,
   spread_ = since_build && np > 0 && std::isfinite(spread)
                 ? spread
                 : std::numeric_limits<double>::infinity();
-  return all.vmax;
+  return std::sqrt(all.vmax);
 }
 
 void ShellGuard::load_points(const std::vector<GridShell>& shells,
