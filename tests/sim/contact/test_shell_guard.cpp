@@ -226,6 +226,77 @@ TEST_CASE("shell guard: the candidate lists never change a result", "[shell_guar
   CHECK(impulses > 0);
 }
 
+TEST_CASE("shell guard: a shell's neighbours at rest are never paired and its far parts are",
+          "[shell_guard]") {
+  // A sheet shrunk in its plane until features within Mesh::near of each other at rest
+  // (the mean rest edge here) come closer than the gap: the guard pairs none of them (its
+  // lists leave the pairs near at rest out). The same sheet folded so that one half lies
+  // within the gap over the other: the guard pairs those.
+  const double size = 0.1;
+  const int res = 10;
+  std::vector<std::unique_ptr<ShellObject>> sh;
+  sh.push_back(sheet(size, res, 0.0));
+  ShellObject& s = *sh[0];
+  const std::vector<Vec3d> rest = limit_positions(s);
+  const LimitMesh L(s.basis(), s.triangles(), {}, 0);
+  double edge = 0;
+  std::size_t edges = 0;
+  for (const Eigen::Vector3i& t : L.triangles())
+    for (int k = 0; k < 3; ++k, ++edges) edge += (rest[t[k]] - rest[t[(k + 1) % 3]]).norm();
+  const double near = std::max(2 * kGap, edge / static_cast<double>(edges));
+  // Shrunk by c: a pair d apart at rest is c d apart. Pairs near at rest (d < near) come
+  // within the gap where d < gap / c; pairs not near stay beyond the gap (c near > gap).
+  const double c = 1.05 * kGap / near;
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    s.x[j] = (s.x[j].cast<double>() * c).cast<Real>();
+    s.v[j].setZero();
+  }
+  // The control: some vertex and triangle not its own are within the gap, all of them
+  // near at rest.
+  const std::vector<Vec3d> now = limit_positions(s);
+  std::size_t close = 0, close_far_at_rest = 0;
+  for (std::size_t p = 0; p < now.size(); ++p)
+    for (const Eigen::Vector3i& t : L.triangles()) {
+      if (t[0] == int(p) || t[1] == int(p) || t[2] == int(p)) continue;
+      const auto dist = [&](const std::vector<Vec3d>& x) {
+        const Vec3d w = closest_point_barycentric(x[p], x[t[0]], x[t[1]], x[t[2]]);
+        return (x[p] - (w[0] * x[t[0]] + w[1] * x[t[1]] + w[2] * x[t[2]])).norm();
+      };
+      if (dist(now) < kGap) {
+        ++close;
+        close_far_at_rest += dist(rest) >= near;
+      }
+    }
+  REQUIRE(close > 0);
+  REQUIRE(close_far_at_rest == 0);
+  std::vector<GridShell> g = grid_shells(sh);
+  ShellGuard guard;
+  guard.setup(g, kGap);
+  CHECK(guard.apply(g, GuardBulk{}, kDt).pairs == 0);
+
+  // Folded: the half x > 0 turned over onto the half x < 0, kGap / 2 above it and coming
+  // down at 1 m/s.
+  std::vector<std::unique_ptr<ShellObject>> fold;
+  fold.push_back(sheet(size, res, 0.0));
+  ShellObject& f = *fold[0];
+  for (std::size_t j = 0; j < f.size(); ++j) {
+    if (f.x[j].x() > Real(1e-6)) {
+      f.x[j] = Vec3(-f.x[j].x(), Real(0.5 * kGap), f.x[j].z());
+      f.v[j] = Vec3(0, -1, 0);
+    } else {
+      f.v[j].setZero();
+    }
+  }
+  // x^n = x - dt v for the guard: put x where the step took it.
+  for (std::size_t j = 0; j < f.size(); ++j) f.x[j] += static_cast<Real>(kDt) * f.v[j];
+  std::vector<GridShell> gf = grid_shells(fold);
+  ShellGuard fold_guard;
+  fold_guard.setup(gf, kGap);
+  const ShellGuardStats st = fold_guard.apply(gf, GuardBulk{}, kDt);
+  CHECK(st.pairs > 0);
+  CHECK(st.impulses > 0);
+}
+
 TEST_CASE("segment closest points", "[shell_guard]") {
   // Crossing at right angles, 1 apart.
   Eigen::Vector2d st =
