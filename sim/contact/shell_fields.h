@@ -215,8 +215,6 @@ class ShellFields {
   void scatter_shares(Field& F, const GridShell& gs, Real dt, bool heights, bool serial, AddFn add);
   /// heights_only_: whether a node of the combined P2G's heights spreads (a fold).
   bool any_spread() const;
-  /// A node whose heights spread by kFoldMinRange cells or more (shell_folds.cpp): two layers.
-  static bool spreads(const NodeHeights& d);
   /// Momentum to velocity, first moment to centroid offset.
   static void normalise(Node& d);
   /// Between the sums and their normalisation in shell_p2g: finds the nodes where F's

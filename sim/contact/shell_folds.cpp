@@ -24,10 +24,6 @@
 
 namespace shellmpm {
 
-bool ShellFields::spreads(const NodeHeights& d) {
-  return heights_spread(d);
-}
-
 void ShellFields::mark_split_nodes(Field& F, bool heights_only) {
   const std::size_t ng = F.grid.num_grid_blocks();
   F.fold.assign(ng, -1);
@@ -41,7 +37,7 @@ void ShellFields::mark_split_nodes(Field& F, bool heights_only) {
         const Node& f = F.nodes[g][n];
         d = {f.m, f.hmin, f.hmax};
       }
-      if (!spreads(d)) continue;
+      if (!heights_spread(d)) continue;
       if (F.fold[g] < 0) {
         // Heights only: the full sums of a fold block come from its classes alone.
         if (heights_only) Node::clear(F.nodes[g].data(), kBlockNodes);

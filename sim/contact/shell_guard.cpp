@@ -95,6 +95,35 @@ double distance_of_segments(const Vec3d& p0, const Vec3d& p1, const Vec3d& q0, c
   return ((p0 + st[0] * (p1 - p0)) - (q0 + st[1] * (q1 - q0))).norm();
 }
 
+/// Per item i < n, the features visit(i, stamp, out) appends (each item's sorted), run in
+/// chunks on the threads with a Stamps over `stamps` features per chunk and joined in
+/// item order: the same lists on any thread count.
+template <class Visit>
+void item_lists(std::size_t n, std::size_t stamps, bool serial, const Visit& visit,
+                std::vector<std::size_t>& start, std::vector<int>& item) {
+  struct Part {
+    std::vector<int> item;
+    std::vector<std::size_t> count;
+  };
+  const std::uint32_t pass = Stamps::new_pass();
+  const auto parts =
+      chunk_parts(n, 512, serial, Part(), [&](std::size_t b, std::size_t e, Part& part) {
+        Stamps stamp(stamps, pass);
+        for (std::size_t i = b; i < e; ++i) {
+          const std::size_t at = part.item.size();
+          visit(i, stamp, part.item);
+          std::sort(part.item.begin() + static_cast<std::ptrdiff_t>(at), part.item.end());
+          part.count.push_back(part.item.size() - at);
+        }
+      });
+  start.assign(1, 0);
+  item.clear();
+  for (const Part& part : parts) {
+    item.insert(item.end(), part.item.begin(), part.item.end());
+    for (std::size_t c : part.count) start.push_back(start.back() + c);
+  }
+}
+
 }  // namespace
 
 void ShellGuard::setup(const std::vector<GridShell>& shells, double gap, bool serial) {
@@ -198,29 +227,8 @@ void ShellGuard::build_rest_near() {
   const auto local = [&](std::size_t g) {
     return static_cast<int>(g - vertex_offset_[vert_shell_[g]]);
   };
-  struct Part {
-    std::vector<int> item;
-    std::vector<std::size_t> count;
-  };
-  // Per item in chunks on the threads, each item's list sorted, joined in order.
   const auto lists = [&](std::size_t n, std::size_t stamps, NearLists& out, const auto& visit) {
-    const std::uint32_t pass = Stamps::new_pass();
-    const auto parts =
-        chunk_parts(n, 512, serial_, Part(), [&](std::size_t b, std::size_t e, Part& part) {
-          Stamps stamp(stamps, pass);
-          for (std::size_t i = b; i < e; ++i) {
-            const std::size_t at = part.item.size();
-            visit(i, stamp, part.item);
-            std::sort(part.item.begin() + static_cast<std::ptrdiff_t>(at), part.item.end());
-            part.count.push_back(part.item.size() - at);
-          }
-        });
-    out.start.assign(1, 0);
-    out.item.clear();
-    for (const Part& part : parts) {
-      out.item.insert(out.item.end(), part.item.begin(), part.item.end());
-      for (std::size_t c : part.count) out.start.push_back(out.start.back() + c);
-    }
+    item_lists(n, stamps, serial_, visit, out.start, out.item);
   };
   // The same tests, in the same order of arguments, as the list builds' rest test used
   // to make per pair: distance_to_triangle(vertex, triangle), distance_of_segments(e, f).
@@ -271,25 +279,16 @@ void ShellGuard::build_shell_candidates(double radius) {
   tri_grid_.build(pos_, all_tris_, cell, 0.0, serial_);
   edge_grid_.build(pos_, all_edges_, cell, 0.0, serial_);
   const Vec3d pad = Vec3d::Constant(radius);
-  // Vertices, then edges, in chunks on the threads; each chunk keeps its own pairs, and
-  // the chunks' pairs are joined in order (the same lists on any thread count).
-  const std::size_t grain = 512;
+  // Vertices, then edges, each item's candidates as item_lists finds them, as pairs.
+  std::vector<std::size_t> start;
+  std::vector<int> item;
   const auto chunked = [&](std::size_t n, std::size_t stamps, std::vector<Eigen::Vector2i>& out,
                            const auto& visit) {
-    const std::uint32_t pass = Stamps::new_pass();
-    const auto parts =
-        chunk_parts(n, grain, serial_, std::vector<Eigen::Vector2i>(),
-                    [&](std::size_t b, std::size_t e, std::vector<Eigen::Vector2i>& part) {
-                      Stamps stamp(stamps, pass);
-                      std::vector<int> cand;
-                      for (std::size_t i = b; i < e; ++i) {
-                        cand.clear();
-                        visit(i, stamp, cand);
-                        std::sort(cand.begin(), cand.end());
-                        for (int f : cand) part.emplace_back(static_cast<int>(i), f);
-                      }
-                    });
-    for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
+    item_lists(n, stamps, serial_, visit, start, item);
+    out.reserve(item.size());
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = start[i]; k < start[i + 1]; ++k)
+        out.emplace_back(static_cast<int>(i), item[k]);
   };
   chunked(pos_.size(), all_tris_.size(), vt_cand_,
           [&](std::size_t p, Stamps& stamp, std::vector<int>& cand) {
