@@ -11,6 +11,8 @@
 // (tests/sim/contact/test_contact_lanes.cpp). Internal to sim/contact.
 #pragma once
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 
 #include "sim/contact/contact_energy.h"
 #include "sim/core/types.h"
@@ -32,6 +34,16 @@ struct FrameLanes {
 struct GradientLanes {
   R a1[3], a2[3], a3e[3];
   R psi, g[3][3];
+};
+
+/// Contact sites' stencils, as ShellContact stores them: site p's control points
+/// idx[off[p] .. off[p + 1]) with the basis values table[3 (row[p] + k) + 0, 1, 2]
+/// (N, dN/dxi1, dN/dxi2) for its k-th; and where their positions and tangents go.
+struct SiteStencils {
+  const Vec3* ctrl;
+  const std::uint32_t *off, *idx, *row;
+  const Real* table;
+  Vec3 *x, *a1, *a2;
 };
 
 /// Fills f's outputs from its inputs.
@@ -61,6 +73,9 @@ template <class V>
 void frames_avx2(FrameLanes& f);  // (also on AVX-512 machines: contact_lanes.cpp)
 void gradients_avx2(GradientLanes& g, const ContactParams& p);
 void gradients_avx512(GradientLanes& g, const ContactParams& p);
+/// x, a1 and a2 of sites [p0, p0 + n) (ShellContact::position_and_tangents, the same
+/// operations on each component: its sums on 4-vectors, three of them in one register).
+void stencils_avx512(const SiteStencils& s, std::size_t p0, std::size_t n);
 
 }  // namespace shellmpm::contact_lanes
 

@@ -152,25 +152,54 @@ SHELLMPM_BLOCKS_INLINE void scatter_heights(HeightsPadNode* pad, const Quadratic
     }
 }
 
+/// The padded-buffer nodes a block's points reached lie in [lo, hi) on each axis (the
+/// union of their stencils).
+struct PadBox {
+  int lo[3] = {kPadSize, kPadSize, kPadSize}, hi[3] = {0, 0, 0};
+  SHELLMPM_BLOCKS_INLINE void add_stencil(int lx, int ly, int lz) {
+    const int l[3] = {lx, ly, lz};
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], l[a]);
+      hi[a] = std::max(hi[a], l[a] + 3);
+    }
+  }
+};
+
 /// Adds the nodes of particle block b's padded buffer of heights that its points reached
-/// into the grid's (FoldHeights::ready).
+/// (all inside box) into the grid's (FoldHeights::ready). Nodes of the box no point
+/// reached hold (0, max, max), which add nothing: so every node of the box is merged,
+/// without a test per node, and the grid blocks the box overlaps are made ready.
 SHELLMPM_BLOCKS_INLINE void merge_heights(const SparseGrid& grid, std::size_t b,
-                                          const HeightsPadNode* pad, FoldHeights& heights) {
+                                          const HeightsPadNode* pad, const PadBox& box,
+                                          FoldHeights& heights) {
   bool spread = false;
-  grid.for_each_pad_node(b, [&](int gb, int bn, int pn) {
-    const HeightsPadNode& p = pad[pn];
-    if (p.m == 0 && p.hmin == std::numeric_limits<Real>::max()) return;  // not reached
-    const auto g = static_cast<std::size_t>(gb);
+  for (int o = 0; o < 8; ++o) {
+    const int oo[3] = {(o >> 2) * 4, ((o >> 1) & 1) * 4, (o & 1) * 4};
+    int lo[3], hi[3];
+    bool empty = false;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(box.lo[a], oo[a]);
+      hi[a] = std::min(box.hi[a], oo[a] ? kPadSize : 4);
+      empty = empty || lo[a] >= hi[a];
+    }
+    if (empty) continue;
+    const auto g = static_cast<std::size_t>(grid.pblock_nbr[b][o]);
     if (!heights.ready[g]) {
       heights.blocks[g].fill(kNoHeights);
       heights.ready[g] = 1;
     }
-    NodeHeights& d = heights.blocks[g][bn];
-    d.m += p.m;
-    d.hmin = std::min(d.hmin, p.hmin);
-    d.hmax = std::max(d.hmax, -p.nhmax);
-    spread = spread || heights_spread(d);
-  });
+    NodeHeights* nodes = heights.blocks[g].data();
+    for (int i = lo[0]; i < hi[0]; ++i)
+      for (int j = lo[1]; j < hi[1]; ++j)
+        for (int k = lo[2]; k < hi[2]; ++k) {
+          const HeightsPadNode& p = pad[pad_node(i, j, k)];
+          NodeHeights& d = nodes[block_node(i - oo[0], j - oo[1], k - oo[2])];
+          d.m += p.m;
+          d.hmin = std::min(d.hmin, p.hmin);
+          d.hmax = std::max(d.hmax, -p.nhmax);
+          spread |= heights_spread(d);
+        }
+  }
   if (spread) heights.spread.store(true, std::memory_order_relaxed);
 }
 
@@ -198,6 +227,7 @@ SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* ord
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
   HeightsPadNode hpad[kPadNodes + 1];
+  PadBox box;
   if (heights)
     std::fill(hpad, hpad + kPadNodes + 1,
               HeightsPadNode{Real(0), std::numeric_limits<Real>::max(),
@@ -213,9 +243,12 @@ SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* ord
     const Mat3 A = (m * dx) * gs.contact->C[j];  // world offset = dx (node - fx)
     const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
     apic_scatter<false>(buf, W, bc, m, m * sh.v[j] + dt * gs.force[j] - A * fx, A, Mat3::Zero());
-    if (heights) scatter_heights(hpad, W, bc, m, heights->normal[j], heights->align);
+    if (heights) {
+      scatter_heights(hpad, W, bc, m, heights->normal[j], heights->align);
+      box.add_stencil(W.base[0] - bc[0], W.base[1] - bc[1], W.base[2] - bc[2]);
+    }
   }
-  if (heights) merge_heights(grid, b, hpad, *heights);
+  if (heights) merge_heights(grid, b, hpad, box, *heights);
 }
 
 /// shell_g2p_block's loop.

@@ -8,6 +8,7 @@
 
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
+#include "sim/mpm/stress_batch.h"
 #include "sim/shell/shell_quadrature.h"
 
 namespace shellmpm {
@@ -276,18 +277,26 @@ ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const F
 
 ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
   using Acc = ReturnMapSums;
+  static_assert(sizeof(StencilWeight) == 3 * sizeof(Real));
+  const contact_lanes::SiteStencils stencils{
+      ctrl,     off.data(), idx.data(), weight_row_.data(), &weight_table_.data()->N,
+      x.data(), a1_.data(), a2_.data()};
   // The frames of kFrameLanes sites at a time (FrameLanes: their square roots and
   // divisions overlap), then each site's return mapping in site order.
   const Acc a =
       ordered_reduce_chunks(num_sites(), kGrain, serial, Acc{}, [&](std::size_t b, std::size_t e) {
         Acc acc;
+        // Positions and tangents (kept for the next forces() call): on AVX-512 for the
+        // chunk at once, with the same operations.
+        const bool wide = simd_level() == SimdLevel::Avx512;
+        if (wide) contact_lanes::stencils_avx512(stencils, b, e - b);
         for (std::size_t p0 = b; p0 < e; p0 += kFrameLanes) {
           const int n = static_cast<int>(std::min<std::size_t>(kFrameLanes, e - p0));
           FrameLanes fl;
           for (int j = 0; j < kFrameLanes; ++j) {
             const std::size_t p = p0 + std::size_t(j < n ? j : 0);
             Vec3 a1, a2;
-            if (j < n) {  // kept for the next forces() call
+            if (j < n && !wide) {
               position_and_tangents(ctrl, p, x[p], a1, a2);
               a1_[p] = a1;
               a2_[p] = a2;
