@@ -260,6 +260,7 @@ SHELLMPM_BLOCKS_INLINE void g2p(const SparseGrid& grid, const std::uint32_t* ord
   if (lo == hi) return;
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
+  const Real c_scale = Real(4) / dx;  // C = B D^-1 with B in grid units times dx
   // The block's control points come first in its slice (the order ascends within a block).
   std::uint32_t s = lo;
   for (; s < hi && order[s] < nc; ++s) {
@@ -272,7 +273,7 @@ SHELLMPM_BLOCKS_INLINE void g2p(const SparseGrid& grid, const std::uint32_t* ord
     const QuadraticWeights W(grid.grid_coord(sh.x[j]));
     const ApicGather G = apic_gather<false>(buf, W, bc);
     const Vec3& v = G.v;
-    gs.contact->C[j] = (Real(4) / dx) * G.B;  // B D^-1 with B in grid units times dx
+    gs.contact->C[j] = c_scale * G.B;
     const std::uint8_t held = gs.held[j];
     for (int a = 0; a < 3; ++a)
       if (!(held & (1u << a))) sh.v[j][a] = v[a];

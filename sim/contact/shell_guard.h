@@ -51,6 +51,7 @@
 #include <vector>
 
 #include "sim/contact/shell_transfer.h"
+#include "sim/math/box_pairs.h"
 #include "sim/math/triangle_queries.h"
 #include "sim/mpm/particles.h"
 #include "sim/shell/limit_mesh.h"
@@ -123,6 +124,8 @@ class ShellGuard {
   std::size_t impact_zones(double tol);
   /// Vertex-triangle and edge-edge pairs closer than radius at pos_ (sorted).
   void build_shell_candidates(double radius);
+  /// Its edge-edge pairs, found cell by cell in cells of side `cell`.
+  void build_edge_candidates(double radius, double cell);
   /// near_vt_, near_ee_ (once: the rest shapes are fixed).
   void build_rest_near();
   /// Bulk particle-triangle pairs closer than radius (particles at x^n, sorted).
@@ -204,7 +207,9 @@ class ShellGuard {
   };
   NearLists near_vt_, near_ee_;
   bool rest_near_built_ = false;
-  TriangleGrid tri_grid_, edge_grid_, bulk_grid_;  ///< used by the list builds only
+  TriangleGrid tri_grid_, bulk_grid_;  ///< used by the list builds only
+  BoxPairs edge_pairs_;
+  std::vector<BoxPairs::Box> edge_box_;  ///< build_edge_candidates: each edge's box
   std::vector<Entry> entries_;
   std::vector<Pair> pairs_;
 };

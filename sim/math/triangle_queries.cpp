@@ -92,17 +92,14 @@ Vec3i TriangleGrid::cell_of(const Vec3d& p) const {
   return c;
 }
 
-void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen::Vector3i>& tris,
-                         double cell, double pad, bool serial) {
+template <class BoxOf>
+void TriangleGrid::build_impl(std::size_t nt, const BoxOf& box_of, double cell, double pad,
+                              bool serial) {
   inv_cell_ = 1.0 / cell;
-  const std::size_t nt = tris.size();
-  // Each triangle's cells (none for a non-finite one), counted, then listed at its offset.
+  // Each item's cells (none for a non-finite box), counted, then listed at its offset.
   auto cells_of = [&](std::size_t t, Vec3i& c0, Vec3i& c1) {
-    Vec3d lo = pos[tris[t][0]], hi = lo;
-    for (int k = 1; k < 3; ++k) {
-      lo = lo.cwiseMin(pos[tris[t][k]]);
-      hi = hi.cwiseMax(pos[tris[t][k]]);
-    }
+    Vec3d lo, hi;
+    box_of(t, lo, hi);
     if (!lo.allFinite() || !hi.allFinite()) return false;
     c0 = cell_of(lo.array() - pad);
     c1 = cell_of(hi.array() + pad);
@@ -157,7 +154,8 @@ void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen:
       },
       serial);
   cells_.clear();
-  std::vector<std::uint64_t> cell_keys;
+  std::vector<std::uint64_t>& cell_keys = cell_key_;
+  cell_keys.clear();
   chunk_keys_.number(cells_, cell_keys);
   cell_start_.assign(cell_keys.size() + 1, 0);
   for (std::size_t c = 0; c < nc; ++c)
@@ -189,6 +187,32 @@ void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen:
     std::vector<std::pair<std::uint64_t, int>>().swap(pairs_);
     std::vector<int>().swap(pair_cell_);
   }
+}
+
+void TriangleGrid::build(const std::vector<Vec3d>& pos, const std::vector<Eigen::Vector3i>& tris,
+                         double cell, double pad, bool serial) {
+  build_impl(
+      tris.size(),
+      [&](std::size_t t, Vec3d& lo, Vec3d& hi) {
+        lo = pos[tris[t][0]];
+        hi = lo;
+        for (int k = 1; k < 3; ++k) {
+          lo = lo.cwiseMin(pos[tris[t][k]]);
+          hi = hi.cwiseMax(pos[tris[t][k]]);
+        }
+      },
+      cell, pad, serial);
+}
+
+void TriangleGrid::build(const std::vector<std::array<double, 6>>& boxes, double cell, double pad,
+                         bool serial) {
+  build_impl(
+      boxes.size(),
+      [&](std::size_t t, Vec3d& lo, Vec3d& hi) {
+        lo = Vec3d(boxes[t][0], boxes[t][1], boxes[t][2]);
+        hi = Vec3d(boxes[t][3], boxes[t][4], boxes[t][5]);
+      },
+      cell, pad, serial);
 }
 
 void TriangleGrid::query(const Vec3d& p, std::vector<int>& out) const {

@@ -4,6 +4,7 @@
 // round-off of its own.
 #pragma once
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -36,6 +37,9 @@ class TriangleGrid {
  public:
   void build(const std::vector<Vec3d>& pos, const std::vector<Eigen::Vector3i>& tris, double cell,
              double pad, bool serial = false);
+  /// The same for boxes (lo x, y, z, hi x, y, z) in place of the triangles' boxes.
+  void build(const std::vector<std::array<double, 6>>& boxes, double cell, double pad,
+             bool serial = false);
   /// Triangles listed in the cell that holds p (a superset of those within `pad` of p).
   void query(const Vec3d& p, std::vector<int>& out) const;
   /// Triangles listed in any cell that the box [lo, hi] overlaps, sorted, no repeats.
@@ -56,15 +60,29 @@ class TriangleGrid {
         }
   }
   bool empty() const { return tri_.empty(); }
+  /// Cells that list something, numbered 0 .. num_cells() - 1.
+  std::size_t num_cells() const { return cell_key_.size(); }
+  /// Cell c's key (key() of its coordinates).
+  std::uint64_t cell_key(std::size_t c) const { return cell_key_[c]; }
+  /// Cell c's triangles, ascending: [first, last).
+  const int* cell_begin(std::size_t c) const { return tri_.data() + cell_start_[c]; }
+  const int* cell_end(std::size_t c) const { return tri_.data() + cell_start_[c + 1]; }
+  /// The cell that holds p: floor(p / cell) per axis. A triangle with bounding box
+  /// [lo, hi] is listed in the cells from cell_of(lo - pad) to cell_of(hi + pad).
+  Vec3i cell_of(const Vec3d& p) const;
+  /// The key of the cell with coordinates c.
+  std::uint64_t key(const Vec3i& c) const;
 
  private:
-  std::uint64_t key(const Vec3i& c) const;
-  Vec3i cell_of(const Vec3d& p) const;
+  /// build() for n items, box_of(i, lo, hi) giving item i's box.
+  template <class BoxOf>
+  void build_impl(std::size_t n, const BoxOf& box_of, double cell, double pad, bool serial);
   double inv_cell_ = 1;
   /// The triangles tri_[cell_start_[c] .. cell_start_[c + 1]) in the cell numbered c by
   /// cells_ (cells by first appearance in triangle order), ascending.
   std::vector<int> tri_;
   std::vector<std::size_t> cell_start_;
+  std::vector<std::uint64_t> cell_key_;  ///< per cell number, its key
   BlockHash cells_;
   // build's work space, kept: the (cell key, triangle) pairs in triangle order, each
   // pair's cell among its chunk's, per chunk its cells' counts (then next slots).

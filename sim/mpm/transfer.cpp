@@ -88,6 +88,14 @@ GridNode* thread_pad() {
   return pad.data();
 }
 
+/// Whether particle block b holds bulk particles (binned from first_bulk on: the last of
+/// its ascending runs reaches there). Blocks of shell points alone skip the bulk work.
+bool has_bulk(const SparseGrid& grid, const TransferParams& tp, std::size_t b) {
+  const std::uint32_t r = grid.block_run_start[b + 1];
+  if (r == grid.block_run_start[b]) return false;
+  return grid.block_runs[r - 1][0] + grid.block_runs[r - 1][1] > tp.first_bulk;
+}
+
 }  // namespace
 
 void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferParams& tp) {
@@ -99,7 +107,10 @@ void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferPar
   grid.for_each_block_by_colour(
       [&](std::size_t b) {
         GridNode* pad = thread_pad();
-        with_scheme(tp, b, pad, block);
+        if (has_bulk(grid, tp, b))
+          with_scheme(tp, b, pad, block);  // zeroes the buffer first
+        else
+          std::memset(static_cast<void*>(pad), 0, kPadNodes * sizeof(GridNode));
         if (tp.others) tp.others(b, pad);
         grid.add_pad_to_grid(b, pad);
       },
@@ -116,7 +127,7 @@ void grid_to_particles(ParticleSet& p, SparseGrid& grid, const TransferParams& t
       [&](std::size_t b) {
         GridNode* pad = thread_pad();
         grid.copy_grid_to_pad(b, pad);
-        with_scheme(tp, b, pad, block);
+        if (has_bulk(grid, tp, b)) with_scheme(tp, b, pad, block);
         if (tp.others) tp.others(b, pad);
       },
       tp.serial);
