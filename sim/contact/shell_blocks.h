@@ -152,19 +152,6 @@ SHELLMPM_BLOCKS_INLINE void scatter_heights(HeightsPadNode* pad, const Quadratic
     }
 }
 
-/// The padded-buffer nodes a block's points reached lie in [lo, hi) on each axis (the
-/// union of their stencils).
-struct PadBox {
-  int lo[3] = {kPadSize, kPadSize, kPadSize}, hi[3] = {0, 0, 0};
-  SHELLMPM_BLOCKS_INLINE void add_stencil(int lx, int ly, int lz) {
-    const int l[3] = {lx, ly, lz};
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], l[a]);
-      hi[a] = std::max(hi[a], l[a] + 3);
-    }
-  }
-};
-
 /// Adds the nodes of particle block b's padded buffer of heights that its points reached
 /// (all inside box) into the grid's (FoldHeights::ready). Nodes of the box no point
 /// reached hold (0, max, max), which add nothing: so every node of the box is merged,
@@ -221,13 +208,13 @@ SHELLMPM_BLOCKS_INLINE void prefetch_control_point(const ShellPointTable& table,
 /// shell_p2g_block's loop.
 SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* order,
                                 const ShellPointTable& table, const std::vector<GridShell>& shells,
-                                Real dt, std::size_t b, GridNode* buf, FoldHeights* heights) {
+                                Real dt, std::size_t b, GridNode* buf, FoldHeights* heights,
+                                PadBox& box) {
   const auto [lo, hi] = slice(grid, order, b, 0, table.num_control_points());
   if (lo == hi) return;
   const Vec3i bc = unpack_block(grid.pblock_key[b]) * kBlockSize;
   const Real dx = static_cast<Real>(grid.dx());
   HeightsPadNode hpad[kPadNodes + 1];
-  PadBox box;
   if (heights)
     std::fill(hpad, hpad + kPadNodes + 1,
               HeightsPadNode{Real(0), std::numeric_limits<Real>::max(),
@@ -243,10 +230,8 @@ SHELLMPM_BLOCKS_INLINE void p2g(const SparseGrid& grid, const std::uint32_t* ord
     const Mat3 A = (m * dx) * gs.contact->C[j];  // world offset = dx (node - fx)
     const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
     apic_scatter<false>(buf, W, bc, m, m * sh.v[j] + dt * gs.force[j] - A * fx, A, Mat3::Zero());
-    if (heights) {
-      scatter_heights(hpad, W, bc, m, heights->normal[j], heights->align);
-      box.add_stencil(W.base[0] - bc[0], W.base[1] - bc[1], W.base[2] - bc[2]);
-    }
+    box.add_stencil(W.base[0] - bc[0], W.base[1] - bc[1], W.base[2] - bc[2]);
+    if (heights) scatter_heights(hpad, W, bc, m, heights->normal[j], heights->align);
   }
   if (heights) merge_heights(grid, b, hpad, box, *heights);
 }
@@ -343,7 +328,7 @@ SHELLMPM_BLOCKS_INLINE bool normal_forces(const SparseGrid& grid, const std::uin
 #define SHELLMPM_SHELL_BLOCKS_DECLARE(isa)                                                         \
   void p2g_##isa(const SparseGrid& grid, const std::uint32_t* order, const ShellPointTable& table, \
                  const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf,      \
-                 FoldHeights* heights);                                                            \
+                 FoldHeights* heights, PadBox& box);                                               \
   void g2p_##isa(const SparseGrid& grid, const std::uint32_t* order, const ShellPointTable& table, \
                  std::vector<GridShell>& shells, Real dt, std::size_t b, const GridNode* buf);     \
   bool normal_forces_##isa(const SparseGrid& grid, const std::uint32_t* order,                     \
@@ -360,8 +345,9 @@ SHELLMPM_SHELL_BLOCKS_DECLARE(avx512)
   __attribute__((flatten)) void p2g_##isa(const SparseGrid& grid, const std::uint32_t* order,     \
                                           const ShellPointTable& table,                           \
                                           const std::vector<GridShell>& shells, Real dt,          \
-                                          std::size_t b, GridNode* buf, FoldHeights* heights) {   \
-    p2g(grid, order, table, shells, dt, b, buf, heights);                                         \
+                                          std::size_t b, GridNode* buf, FoldHeights* heights,     \
+                                          PadBox& box) {                                          \
+    p2g(grid, order, table, shells, dt, b, buf, heights, box);                                    \
   }                                                                                               \
   __attribute__((flatten)) void g2p_##isa(const SparseGrid& grid, const std::uint32_t* order,     \
                                           const ShellPointTable& table,                           \

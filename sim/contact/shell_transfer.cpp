@@ -29,12 +29,20 @@ void ShellPointTable::build(const std::vector<GridShell>& shells) {
   single_ = shells.size() == 1;
 }
 
-void ShellPointTable::positions(const std::vector<GridShell>& shells,
-                                std::vector<Vec3>& out) const {
-  out.clear();
-  out.reserve(size());
-  for (const GridShell& g : shells) out.insert(out.end(), g.shell->x.begin(), g.shell->x.end());
-  for (const GridShell& g : shells) out.insert(out.end(), g.contact->x.begin(), g.contact->x.end());
+void ShellPointTable::positions(const std::vector<GridShell>& shells, std::vector<Vec3>& out,
+                                bool serial) const {
+  out.resize(size());
+  std::size_t at = 0;
+  const auto copy = [&](const std::vector<Vec3>& x) {
+    Vec3* to = out.data() + at;
+    parallel_for(
+        x.size(), 65536,
+        [&](std::size_t b, std::size_t e) { std::copy(x.data() + b, x.data() + e, to + b); },
+        serial);
+    at += x.size();
+  };
+  for (const GridShell& g : shells) copy(g.shell->x);
+  for (const GridShell& g : shells) copy(g.contact->x);
 }
 
 void ShellPointTable::velocities(const std::vector<GridShell>& shells,
@@ -67,17 +75,25 @@ void prescribe_pins(ShellObject& sh, double t, double dt, std::vector<std::uint8
 
 void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
                      const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf,
-                     FoldHeights* heights) {
+                     FoldHeights* heights, PadBox* box) {
   const std::uint32_t* order = grid.order().data();
+  PadBox reached;
   switch (simd_level()) {
     case SimdLevel::Avx512:
-      return shell_blocks::p2g_avx512(grid, order, table, shells, dt, b, buf, heights);
+      shell_blocks::p2g_avx512(grid, order, table, shells, dt, b, buf, heights, reached);
+      break;
     case SimdLevel::Avx2:
-      return shell_blocks::p2g_avx2(grid, order, table, shells, dt, b, buf, heights);
+      shell_blocks::p2g_avx2(grid, order, table, shells, dt, b, buf, heights, reached);
+      break;
     case SimdLevel::Sse:
+      shell_blocks::p2g(grid, order, table, shells, dt, b, buf, heights, reached);
       break;
   }
-  shell_blocks::p2g(grid, order, table, shells, dt, b, buf, heights);
+  if (box && !reached.empty())
+    for (int a = 0; a < 3; ++a) {
+      box->lo[a] = std::min(box->lo[a], reached.lo[a]);
+      box->hi[a] = std::max(box->hi[a], reached.hi[a]);
+    }
 }
 
 void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,

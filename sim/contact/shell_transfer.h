@@ -45,7 +45,8 @@ class ShellPointTable {
   std::size_t size() const { return shell_.size(); }
   std::uint32_t num_control_points() const { return num_ctrl_; }
   /// Current positions in binning order (control points, then contact particles).
-  void positions(const std::vector<GridShell>& shells, std::vector<Vec3>& out) const;
+  void positions(const std::vector<GridShell>& shells, std::vector<Vec3>& out,
+                 bool serial = false) const;
   /// Velocities in binning order: the control points', zero for contact particles (they
   /// move with them).
   void velocities(const std::vector<GridShell>& shells, std::vector<Vec3>& out) const;
@@ -110,10 +111,10 @@ struct FoldHeights {
 /// P2G of the control points binned in particle block b into its buffer: mass, APIC
 /// momentum and dt * force, with weights w_ij; where `heights` is not null, also their
 /// fold heights into heights->blocks (call colour by colour: blocks of a colour touch
-/// disjoint nodes).
+/// disjoint nodes). Where box is not null, it is grown to cover the nodes written.
 void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
                      const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf,
-                     FoldHeights* heights = nullptr);
+                     FoldHeights* heights = nullptr, PadBox* box = nullptr);
 
 /// G2P for block b: control points get v, C and x += dt v (held components keep their
 /// prescribed velocity); contact particles a3E <- (I + dt grad~v) a3E.

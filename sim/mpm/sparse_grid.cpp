@@ -262,6 +262,44 @@ void SparseGrid::add_pad_to_grid(std::size_t b, const GridNode* pad) {
   }
 }
 
+void SparseGrid::add_pad_to_grid(std::size_t b, const GridNode* pad, const PadBox& box) {
+  for (int o = 0; o < 8; ++o) {
+    // The box's part in this grid block: pad nodes [lo, hi) per axis, offset by oo.
+    const int oo[3] = {(o >> 2) * 4, ((o >> 1) & 1) * 4, (o & 1) * 4};
+    int lo[3], hi[3];
+    bool none = false;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::max(box.lo[a], oo[a]);
+      hi[a] = std::min(box.hi[a], oo[a] ? kPadSize : kBlockSize);
+      none = none || lo[a] >= hi[a];
+    }
+    if (none) continue;  // all 0 here: the block is left as it is (or to zero_unset_blocks)
+    const int g = pblock_nbr[b][o];
+    GridNode* nodes = gblock_nodes[g].data();
+    if (gblock_unset_[g]) {
+      gblock_unset_[g] = 0;
+      std::memset(static_cast<void*>(nodes), 0, sizeof(gblock_nodes[g]));
+      for (int i = lo[0]; i < hi[0]; ++i)
+        for (int j = lo[1]; j < hi[1]; ++j)
+          for (int k = lo[2]; k < hi[2]; ++k)
+            nodes[block_node(i - oo[0], j - oo[1], k - oo[2])] = pad[pad_node(i, j, k)];
+      continue;
+    }
+    for (int i = lo[0]; i < hi[0]; ++i)
+      for (int j = lo[1]; j < hi[1]; ++j)
+        for (int k = lo[2]; k < hi[2]; ++k)
+          add_node(nodes[block_node(i - oo[0], j - oo[1], k - oo[2])], pad[pad_node(i, j, k)]);
+  }
+}
+
+void SparseGrid::zero_pad_box(GridNode* pad, const PadBox& box) {
+  if (box.empty()) return;
+  const auto run = static_cast<std::size_t>(box.hi[2] - box.lo[2]) * sizeof(GridNode);
+  for (int i = box.lo[0]; i < box.hi[0]; ++i)
+    for (int j = box.lo[1]; j < box.hi[1]; ++j)
+      std::memset(static_cast<void*>(pad + pad_node(i, j, box.lo[2])), 0, run);
+}
+
 void SparseGrid::copy_grid_to_pad(std::size_t b, GridNode* pad) const {
   for_each_pad_node(b, [&](int g, int bn, int pn) { pad[pn] = gblock_nodes[g][bn]; });
 }

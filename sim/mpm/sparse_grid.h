@@ -45,6 +45,21 @@ inline int pad_node(int i, int j, int k) {
   return (i * kPadSize + j) * kPadSize + k;
 }
 
+/// Nodes of a padded buffer in [lo, hi) on each axis: the union of the stencils of the
+/// points a block scattered (empty until one is added).
+struct PadBox {
+  int lo[3] = {kPadSize, kPadSize, kPadSize}, hi[3] = {0, 0, 0};
+  /// Adds the stencil with lowest node (lx, ly, lz) in the buffer.
+  void add_stencil(int lx, int ly, int lz) {
+    const int l[3] = {lx, ly, lz};
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], l[a]);
+      hi[a] = std::max(hi[a], l[a] + 3);
+    }
+  }
+  bool empty() const { return lo[0] >= hi[0]; }
+};
+
 class SparseGrid {
  public:
   /// dx: spacing [m]; origin: world position of node (0,0,0) [m].
@@ -178,6 +193,11 @@ class SparseGrid {
   /// Adds a padded buffer of particle block b into the grid nodes it overlaps (a grid
   /// block not yet reached since the last bin takes the buffer's nodes, 0 elsewhere).
   void add_pad_to_grid(std::size_t b, const GridNode* pad);
+  /// The same where the buffer is 0 outside box: only the nodes in it are added (adding
+  /// +0 changes no node: the sums never hold -0).
+  void add_pad_to_grid(std::size_t b, const GridNode* pad, const PadBox& box);
+  /// Zeroes the nodes of a padded buffer in box.
+  static void zero_pad_box(GridNode* pad, const PadBox& box);
   /// Zeroes the grid blocks no add_pad_to_grid has reached since the last bin.
   void zero_unset_blocks(bool serial = false);
   /// Copies the grid nodes that particle block b's padded region overlaps into pad.

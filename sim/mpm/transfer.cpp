@@ -88,6 +88,12 @@ GridNode* thread_pad() {
   return pad.data();
 }
 
+/// A thread's padded buffer that is all 0 between uses (TransferParams::others_boxed).
+GridNode* thread_clean_pad() {
+  alignas(64) thread_local std::array<GridNode, kPadNodes> pad{};
+  return pad.data();
+}
+
 /// Whether particle block b holds bulk particles (binned from first_bulk on: the last of
 /// its ascending runs reaches there). Blocks of shell points alone skip the bulk work.
 bool has_bulk(const SparseGrid& grid, const TransferParams& tp, std::size_t b) {
@@ -106,8 +112,18 @@ void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferPar
   // into a thread's padded buffer and from there straight into the grid.
   grid.for_each_block_by_colour(
       [&](std::size_t b) {
+        const bool bulk = has_bulk(grid, tp, b);
+        if (!bulk && tp.others_boxed) {
+          // Shell points alone: the nodes they reached, in a buffer kept all 0 between uses.
+          GridNode* pad = thread_clean_pad();
+          PadBox box;
+          tp.others_boxed(b, pad, box);
+          grid.add_pad_to_grid(b, pad, box);
+          SparseGrid::zero_pad_box(pad, box);
+          return;
+        }
         GridNode* pad = thread_pad();
-        if (has_bulk(grid, tp, b))
+        if (bulk)
           with_scheme(tp, b, pad, block);  // zeroes the buffer first
         else
           std::memset(static_cast<void*>(pad), 0, kPadNodes * sizeof(GridNode));

@@ -25,6 +25,10 @@ struct TransferParams {
   /// Called for every particle block after its bulk particles, with the block's padded
   /// buffer, to scatter (P2G) or gather (G2P) the other points of the block.
   std::function<void(std::size_t block, GridNode* buf)> others;
+  /// P2G, where set: in place of `others` for a block without bulk particles. Its buffer
+  /// is all 0 on entry, and it grows `box` to cover every node it writes (only those are
+  /// added to the grid and zeroed again).
+  std::function<void(std::size_t block, GridNode* buf, PadBox& box)> others_boxed;
 };
 
 /// P2G: writes grid mass and momentum including dt * internal force (grid must be binned).

@@ -306,7 +306,8 @@ void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinem
 template <class T>
 typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec3T* x,
                                                                        Vec3T* forces, bool serial,
-                                                                       bool membrane) const {
+                                                                       bool membrane,
+                                                                       bool total) const {
   const std::size_t nq = area_.size();
   // Each basis entry's share of its control point's force, in gather order (eval_points
   // writes every one). The object keeps the array between calls (a fresh one per call, 36 MB
@@ -338,7 +339,8 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
                     double et = 0.0, em = 0.0;
                     if constexpr (std::is_same_v<T, float>) {
                       if (patched) {
-                        eval_patch_range(b, e - b, x, fe, et, membrane ? &em : nullptr);
+                        eval_patch_range(b, e - b, x, fe, total || membrane ? &et : nullptr,
+                                         membrane ? &em : nullptr);
                         part = {et, em};
                         return;
                       }
@@ -368,7 +370,7 @@ typename KirchhoffLoveShellT<T>::Energy KirchhoffLoveShellT<T>::energy(const Vec
         serial);
   }
   Energy out;
-  out.total = T(et);
+  out.total = total || membrane ? T(et) : std::numeric_limits<T>::quiet_NaN();
   out.membrane = membrane ? T(em) : std::numeric_limits<T>::quiet_NaN();
   out.bending = membrane ? T(et - em) : std::numeric_limits<T>::quiet_NaN();
   return out;

@@ -126,7 +126,10 @@ class KirchhoffLoveShellT {
   /// membrane: split the energy into membrane and bending (a diagnostic: one more energy
   /// evaluation per quadrature point, measured 4% of a force evaluation on a 20k-point
   /// sheet); without it Energy::membrane and ::bending are NaN and only total is set.
-  Energy energy(const Vec3T* x, Vec3T* forces, bool serial = false, bool membrane = true) const;
+  /// total: sum the energy (without it, and without membrane, every part is NaN: the
+  /// forces alone, for the explicit step, which has no use for the energy).
+  Energy energy(const Vec3T* x, Vec3T* forces, bool serial = false, bool membrane = true,
+                bool total = true) const;
 
   /// Denting return mapping (supplement sec. 7) for every quadrature point and layer at
   /// positions x; updates the stored plastic state. Returns the plastic work dissipated
@@ -207,8 +210,9 @@ class KirchhoffLoveShellT {
   kl::BatchData batch_data() const;
   /// eval_points for the patches at positions i0 .. i0 + n - 1 of patches_.order (their
   /// points' energies added in that order, point by point), each patch entry's force share
-  /// at its slot in the patches' gather order. Float only (sim/shell/kl_batch.cpp).
-  void eval_patch_range(std::size_t i0, std::size_t n, const Vec3T* x, T* fe, double& e_total,
+  /// at its slot in the patches' gather order. Float only (sim/shell/kl_batch.cpp). A
+  /// null e_total: no energies summed (the forces alone).
+  void eval_patch_range(std::size_t i0, std::size_t n, const Vec3T* x, T* fe, double* e_total,
                         double* e_membrane) const;
   /// From point q's adjoints G (15 values), writes each of its entries' dE/dx share (3
   /// values and a zero, so that one SSE store writes a share) at the entry's slot in gather
@@ -264,7 +268,7 @@ template <>
 kl::BatchData KirchhoffLoveShellT<float>::batch_data() const;
 template <>
 void KirchhoffLoveShellT<float>::eval_patch_range(std::size_t i0, std::size_t n, const Vec3T* x,
-                                                  float* fe, double& e_total,
+                                                  float* fe, double* e_total,
                                                   double* e_membrane) const;
 using KirchhoffLoveShell = KirchhoffLoveShellT<Real>;
 

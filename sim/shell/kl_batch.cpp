@@ -60,7 +60,7 @@ void KirchhoffLoveShellT<float>::eval_points(std::size_t q0, std::size_t n, cons
 
 template <>
 void KirchhoffLoveShellT<float>::eval_patch_range(std::size_t i0, std::size_t n, const Vec3T* x,
-                                                  float* fe, double& e_total,
+                                                  float* fe, double* e_total,
                                                   double* e_membrane) const {
   const kl::BatchData d = batch_data();
   const kl::Patches& pt = patches_;
@@ -81,10 +81,11 @@ void KirchhoffLoveShellT<float>::eval_patch_range(std::size_t i0, std::size_t n,
   for (std::size_t b = i0; b < i0 + n; b += kChunk) {
     const std::size_t m = std::min(kChunk, i0 + n - b);
     run(d, p, b, m, xs, fe, energy, e_membrane ? a12 : nullptr);
+    if (!e_total) continue;
     for (std::size_t i = 0; i < m; ++i)
       for (std::size_t k = 0; k < P; ++k) {
         const std::size_t o = i * P + k;
-        e_total += double(energy[o]);
+        *e_total += double(energy[o]);
         if (e_membrane) {
           const std::size_t q = std::size_t(pt.order[b + i]) * P + k;
           *e_membrane += membrane_energy(q, Vec3T(a12[6 * o], a12[6 * o + 1], a12[6 * o + 2]),

@@ -34,11 +34,16 @@ void quadrature_points(const LoopBasis& basis, int num_faces, int inplane_points
 template <class T>
 void add_loads(const ShellDesc& desc, const std::vector<Eigen::Vector3i>& tris,
                const std::vector<Real>& mass, const Vec3d& gravity,
-               const std::vector<Eigen::Matrix<T, 3, 1>>& x,
-               std::vector<Eigen::Matrix<T, 3, 1>>& f) {
+               const std::vector<Eigen::Matrix<T, 3, 1>>& x, std::vector<Eigen::Matrix<T, 3, 1>>& f,
+               bool serial) {
   using V3 = Eigen::Matrix<T, 3, 1>;
   const V3 g = gravity.cast<T>();
-  for (std::size_t i = 0; i < x.size(); ++i) f[i] += static_cast<T>(mass[i]) * g;
+  parallel_for(
+      x.size(), 16384,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) f[i] += static_cast<T>(mass[i]) * g;
+      },
+      serial);
   if (desc.pressure != 0) {
     // Pressure on the control mesh: p * area * normal, a third to each corner.
     for (const auto& t : tris) {
@@ -133,12 +138,11 @@ ShellObject::ShellObject(const ShellDesc& desc, const ShellMaterialDesc& mat, Sh
     }
 }
 
-KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector<Vec3>& f,
-                                               bool serial) const {
+void ShellObject::forces(const Vec3d& gravity, std::vector<Vec3>& f, bool serial) const {
   const std::size_t n = x.size();
   f.assign(n, Vec3::Zero());
   // The membrane/bending split is a statistic (Solver::measure): not on the hot path.
-  const KirchhoffLoveShell::Energy e = kl_->energy(x.data(), f.data(), serial, false);
+  kl_->energy(x.data(), f.data(), serial, false, false);
   if (mat_.stiffness_damping > 0) {
     // Rayleigh stiffness damping -beta K v, with K v from the directional derivative of
     // the elastic force: f(x + eps v) - f(x) = -eps K v + O(eps^2).
@@ -146,12 +150,11 @@ KirchhoffLoveShell::Energy ShellObject::forces(const Vec3d& gravity, std::vector
     const Real eps = Real(1e-4);
     std::vector<Vec3> xs(n), f2(n, Vec3::Zero());
     for (std::size_t i = 0; i < n; ++i) xs[i] = x[i] + eps * v[i];
-    kl_->energy(xs.data(), f2.data(), serial, false);
+    kl_->energy(xs.data(), f2.data(), serial, false, false);
     const Real c = static_cast<Real>(mat_.stiffness_damping) / eps;
     for (std::size_t i = 0; i < n; ++i) f[i] += c * (f2[i] - f[i]);
   }
-  add_loads(desc_, tris_, mass, gravity, x, f);
-  return e;
+  add_loads(desc_, tris_, mass, gravity, x, f, serial);
 }
 
 std::unique_ptr<KirchhoffLoveShellT<double>> ShellObject::double_kl(
@@ -196,7 +199,7 @@ void ShellObject::sync_double_kl(KirchhoffLoveShellT<double>& kl) const {
 void ShellObject::external_forces(const Vec3d& gravity, const std::vector<Vec3d>& at,
                                   std::vector<Vec3d>& f) const {
   f.assign(at.size(), Vec3d::Zero());
-  add_loads(desc_, tris_, mass, gravity, at, f);
+  add_loads(desc_, tris_, mass, gravity, at, f, true);
 }
 
 StaticSolveResult ShellObject::settle(const Vec3d& gravity, double time, double tolerance,
@@ -224,7 +227,7 @@ StaticSolveResult ShellObject::settle(const Vec3d& gravity, double time, double 
   }
   auto total_force = [&](const std::vector<Vec3d>& p, std::vector<Vec3d>& f) {
     kl.energy(p.data(), f.data(), serial, false);
-    add_loads(desc_, tris_, mass, gravity, p, f);
+    add_loads(desc_, tris_, mass, gravity, p, f, serial);
   };
   const StaticSolveResult r = solve_static(xd, free_mask, total_force, opt);
   for (std::size_t i = 0; i < n; ++i) {

@@ -29,8 +29,8 @@ class ShellObject {
   std::size_t size() const { return x.size(); }
 
   /// Internal (elastic) forces plus gravity, pressure and point loads into `f`
-  /// (resized); returns the elastic energy split.
-  KirchhoffLoveShell::Energy forces(const Vec3d& gravity, std::vector<Vec3>& f, bool serial) const;
+  /// (resized). (The energy is not summed: Solver::measure takes it once a frame.)
+  void forces(const Vec3d& gravity, std::vector<Vec3>& f, bool serial) const;
   /// Static equilibrium under the elastic forces, gravity, pressure and point loads, with
   /// pinned components held at their pin pose at `time` (pre-roll). Positions, forces
   /// and the solve are in double (a temporary double copy of the Kirchhoff-Love data):

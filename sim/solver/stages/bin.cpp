@@ -10,7 +10,7 @@ bool BinStage::needed(const Scene& s) {
 
 void BinStage::run(StepContext& c) {
   const bool shells = !c.grid_shells.empty();
-  if (shells) c.shell_table.positions(c.grid_shells, c.shell_points);
+  if (shells) c.shell_table.positions(c.grid_shells, c.shell_points, c.opt.serial);
   c.grid.bin(shells ? &c.shell_points : nullptr, c.particles.x, c.opt.serial);
 }
 

@@ -1,5 +1,6 @@
 #include "sim/solver/stages/shell_forces.h"
 
+#include "sim/core/parallel.h"
 #include "sim/solver/stages/scene_rules.h"
 
 namespace shellmpm {
@@ -22,8 +23,12 @@ void ShellForcesStage::run(StepContext& c) {
     sh.forces(zero, c.shell_forces[i], c.opt.serial);
     const Real damp = static_cast<Real>(sh.material().damping);
     if (damp > 0)
-      for (std::size_t j = 0; j < sh.size(); ++j)
-        c.shell_forces[i][j] -= damp * sh.mass[j] * sh.v[j];
+      parallel_for(
+          sh.size(), 16384,
+          [&](std::size_t b, std::size_t e) {
+            for (std::size_t j = b; j < e; ++j) c.shell_forces[i][j] -= damp * sh.mass[j] * sh.v[j];
+          },
+          c.opt.serial);
   }
 }
 
