@@ -36,8 +36,7 @@ ShellContact::ShellContact(const LoopBasis& basis, const std::vector<Vec3d>& res
   x.resize(ns);
   a3e.resize(ns);
   G3.assign(ns, Vec3::Zero());
-  G1_.assign(ns, Vec3::Zero());
-  G2_.assign(ns, Vec3::Zero());
+  G12_.assign(ns, GradRows{});
   a1_.assign(ns, Vec3::Zero());
   a2_.assign(ns, Vec3::Zero());
   volume.resize(ns);
@@ -195,8 +194,11 @@ double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
           for (int j = 0; j < n; ++j) {
             const std::size_t p = sites[j];
             const Real V = volume[p];
-            G1_[p] = V * Vec3(gl.g[0][0][j], gl.g[0][1][j], gl.g[0][2][j]);
-            G2_[p] = V * Vec3(gl.g[1][0][j], gl.g[1][1][j], gl.g[1][2][j]);
+            GradRows& G = G12_[p];
+            for (int c = 0; c < 3; ++c) {
+              G.g1[c] = V * gl.g[0][c][j];
+              G.g2[c] = V * gl.g[1][c][j];
+            }
             G3[p] = Vec3(gl.g[2][0][j], gl.g[2][1][j], gl.g[2][2][j]);
             acc += static_cast<double>(V * gl.psi[j]);
           }
@@ -205,7 +207,8 @@ double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
         for (std::size_t p = b; p < en; ++p) {
           if (state[p] == separated) {
             if (!kept) x[p] = position(ctrl, p);
-            G1_[p] = G2_[p] = G3[p] = Vec3::Zero();
+            G12_[p] = GradRows{};
+            G3[p] = Vec3::Zero();
             continue;
           }
           sites[n++] = p;
@@ -218,10 +221,16 @@ double ShellContact::forces(const Vec3* ctrl, Vec3* f, bool serial) {
       num_control_points(), kGrain,
       [&](std::size_t b, std::size_t en) {
         for (std::size_t j = b; j < en; ++j) {
-          Vec3 acc = Vec3::Zero();
-          for (std::uint32_t k = toff[j]; k < toff[j + 1]; ++k)
-            acc += tN1[k] * G1_[tsite[k]] + tN2[k] * G2_[tsite[k]];
-          f[j] -= acc;
+          // acc += N1 G1 + N2 G2 per component, on (x, y, z, 0).
+          R4 acc = {};
+          for (std::uint32_t k = toff[j]; k < toff[j + 1]; ++k) {
+            const GradRows& G = G12_[tsite[k]];
+            R4 g1, g2;
+            std::memcpy(&g1, G.g1, sizeof g1);
+            std::memcpy(&g2, G.g2, sizeof g2);
+            acc += tN1[k] * g1 + tN2[k] * g2;
+          }
+          f[j] -= Vec3(acc[0], acc[1], acc[2]);
         }
       },
       serial);

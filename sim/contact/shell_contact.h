@@ -112,7 +112,13 @@ class ShellContact {
   // The distinct stencil weights (weights()): site p's from weight_table_[weight_row_[p]].
   std::vector<StencilWeight> weight_table_;
   std::vector<std::uint32_t> weight_row_;
-  std::vector<Vec3> G1_, G2_;
+  /// Per site, V dpsi/da1 and V dpsi/da2 of the last forces() call, each as (x, y, z, 0)
+  /// in one 32-byte row (the force gather reads both with two vector loads).
+  struct GradRows {
+    alignas(32) Real g1[4];
+    Real g2[4];
+  };
+  std::vector<GradRows> G12_;
 };
 
 }  // namespace shellmpm

@@ -266,12 +266,12 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
   const double sites = T * m.contact_samples;
   n.contact_sites += sites;
   const double site_support = S;
-  // (Per site: x, a3E, G3, volume, state, stencil and transposed stencil, G1, G2 and the
-  // return mapping's tangents; per control point C, the transposed offsets and the
-  // tangents' control points. A stencil's weights are shared by the sites that have the
+  // (Per site: x, a3E, G3, volume, state, stencil and transposed stencil, G1 and G2 (in
+  // eight floats) and the return mapping's tangents; per control point C, the transposed offsets
+  // and the tangents' control points. A stencil's weights are shared by the sites that have the
   // same ones: all but about one site in ten, those at irregular vertices and borders.)
   t.contact_bytes += sites * (3 * kVec3 + R + 1 + 4 + 4 + site_support * (4 + 0.1 * 3 * R) +
-                              site_support * (4 + 2 * R) + 4 * kVec3) +
+                              site_support * (4 + 2 * R) + 8 * R + 2 * kVec3) +
                      V * (kMat3 + 4 + kVec3);
   // The integrity monitor's own limit mesh (level 0), edges, rim distances, positions.
   t.integrity_bytes += limit_mesh_bytes(V, T, S, false) + V * (8 + 48 + 3) + 1.5 * T * 8;
@@ -280,11 +280,12 @@ void add_shell_memory(const Scene& scene, std::size_t i, MemoryCounts& n, ShellT
   // (double); the triangle and edge grids of a list build, each feature in about 4 cells
   // (a sorted (key, feature) pair plus the kept key and feature), and the stamps; the
   // pairs near at rest (measured on a regular sheet: 14 triangles per vertex, 12 edges
-  // per edge, as ints, and an offset per vertex and per edge).
+  // per edge, as ints, and an offset per vertex and per edge); the edges' boxes and first
+  // cells (BoxPairs).
   if (shot.shell_guard)
     t.guard_bytes += limit_mesh_bytes(V, T, S, false) + 1.5 * T * 8 + V * (24 + 8) + V * 4 * 24 +
                      2.5 * T * 4 * (16 + 12) + 2.5 * T * 4 + V * (14 + 1.5 * 12) * 4 +
-                     (V + 1.5 * T) * 8;
+                     (V + 1.5 * T) * 8 + 1.5 * T * (48 + 8);
   // Shell table, binned positions, pin holds and the force buffer of the grid shell.
   t.grid_points += V;
   t.shell_bytes += V * (2 + 4 + kVec3 + 1 + kVec3);
