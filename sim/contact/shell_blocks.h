@@ -161,15 +161,8 @@ SHELLMPM_BLOCKS_INLINE void merge_heights(const SparseGrid& grid, std::size_t b,
                                           FoldHeights& heights) {
   bool spread = false;
   for (int o = 0; o < 8; ++o) {
-    const int oo[3] = {(o >> 2) * 4, ((o >> 1) & 1) * 4, (o & 1) * 4};
-    int lo[3], hi[3];
-    bool empty = false;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(box.lo[a], oo[a]);
-      hi[a] = std::min(box.hi[a], oo[a] ? kPadSize : 4);
-      empty = empty || lo[a] >= hi[a];
-    }
-    if (empty) continue;
+    int oo[3], lo[3], hi[3];
+    if (!box.in_octant(o, oo, lo, hi)) continue;
     const auto g = static_cast<std::size_t>(grid.pblock_nbr[b][o]);
     if (!heights.ready[g]) {
       heights.blocks[g].fill(kNoHeights);

@@ -264,16 +264,10 @@ void SparseGrid::add_pad_to_grid(std::size_t b, const GridNode* pad) {
 
 void SparseGrid::add_pad_to_grid(std::size_t b, const GridNode* pad, const PadBox& box) {
   for (int o = 0; o < 8; ++o) {
-    // The box's part in this grid block: pad nodes [lo, hi) per axis, offset by oo.
-    const int oo[3] = {(o >> 2) * 4, ((o >> 1) & 1) * 4, (o & 1) * 4};
-    int lo[3], hi[3];
-    bool none = false;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::max(box.lo[a], oo[a]);
-      hi[a] = std::min(box.hi[a], oo[a] ? kPadSize : kBlockSize);
-      none = none || lo[a] >= hi[a];
-    }
-    if (none) continue;  // all 0 here: the block is left as it is (or to zero_unset_blocks)
+    // The box's part in this grid block: pad nodes [lo, hi) per axis, offset by oo. None:
+    // all 0 here, the block is left as it is (or to zero_unset_blocks).
+    int oo[3], lo[3], hi[3];
+    if (!box.in_octant(o, oo, lo, hi)) continue;
     const int g = pblock_nbr[b][o];
     GridNode* nodes = gblock_nodes[g].data();
     if (gblock_unset_[g]) {

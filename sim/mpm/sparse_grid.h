@@ -58,6 +58,18 @@ struct PadBox {
     }
   }
   bool empty() const { return lo[0] >= hi[0]; }
+  /// Its part in octant o of the buffer (grid block pblock_nbr[b][o], whose first node is
+  /// the buffer's node oo): nodes [lo, hi) per axis; false where there is none.
+  bool in_octant(int o, int (&oo)[3], int (&part_lo)[3], int (&part_hi)[3]) const {
+    bool any = true;
+    for (int a = 0; a < 3; ++a) {
+      oo[a] = ((o >> (2 - a)) & 1) * kBlockSize;
+      part_lo[a] = std::max(lo[a], oo[a]);
+      part_hi[a] = std::min(hi[a], oo[a] ? kPadSize : kBlockSize);
+      any = any && part_lo[a] < part_hi[a];
+    }
+    return any;
+  }
 };
 
 class SparseGrid {
