@@ -77,23 +77,17 @@ void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,
                      const std::vector<GridShell>& shells, Real dt, std::size_t b, GridNode* buf,
                      FoldHeights* heights, PadBox* box) {
   const std::uint32_t* order = grid.order().data();
-  PadBox reached;
+  PadBox own;
+  PadBox& reached = box ? *box : own;
   switch (simd_level()) {
     case SimdLevel::Avx512:
-      shell_blocks::p2g_avx512(grid, order, table, shells, dt, b, buf, heights, reached);
-      break;
+      return shell_blocks::p2g_avx512(grid, order, table, shells, dt, b, buf, heights, reached);
     case SimdLevel::Avx2:
-      shell_blocks::p2g_avx2(grid, order, table, shells, dt, b, buf, heights, reached);
-      break;
+      return shell_blocks::p2g_avx2(grid, order, table, shells, dt, b, buf, heights, reached);
     case SimdLevel::Sse:
-      shell_blocks::p2g(grid, order, table, shells, dt, b, buf, heights, reached);
       break;
   }
-  if (box && !reached.empty())
-    for (int a = 0; a < 3; ++a) {
-      box->lo[a] = std::min(box->lo[a], reached.lo[a]);
-      box->hi[a] = std::max(box->hi[a], reached.hi[a]);
-    }
+  shell_blocks::p2g(grid, order, table, shells, dt, b, buf, heights, reached);
 }
 
 void shell_g2p_block(const SparseGrid& grid, const ShellPointTable& table,

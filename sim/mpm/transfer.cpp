@@ -88,7 +88,7 @@ GridNode* thread_pad() {
   return pad.data();
 }
 
-/// A thread's padded buffer that is all 0 between uses (TransferParams::others_boxed).
+/// A thread's padded buffer that is all 0 between uses (blocks without bulk particles).
 GridNode* thread_clean_pad() {
   alignas(64) thread_local std::array<GridNode, kPadNodes> pad{};
   return pad.data();
@@ -112,22 +112,18 @@ void particles_to_grid(const ParticleSet& p, SparseGrid& grid, const TransferPar
   // into a thread's padded buffer and from there straight into the grid.
   grid.for_each_block_by_colour(
       [&](std::size_t b) {
-        const bool bulk = has_bulk(grid, tp, b);
-        if (!bulk && tp.others_boxed) {
-          // Shell points alone: the nodes they reached, in a buffer kept all 0 between uses.
+        if (!has_bulk(grid, tp, b)) {
+          // Other points alone: the nodes they reached, in a buffer kept all 0 between uses.
           GridNode* pad = thread_clean_pad();
           PadBox box;
-          tp.others_boxed(b, pad, box);
+          if (tp.others) tp.others(b, pad, &box);
           grid.add_pad_to_grid(b, pad, box);
           SparseGrid::zero_pad_box(pad, box);
           return;
         }
         GridNode* pad = thread_pad();
-        if (bulk)
-          with_scheme(tp, b, pad, block);  // zeroes the buffer first
-        else
-          std::memset(static_cast<void*>(pad), 0, kPadNodes * sizeof(GridNode));
-        if (tp.others) tp.others(b, pad);
+        with_scheme(tp, b, pad, block);  // zeroes the buffer first
+        if (tp.others) tp.others(b, pad, nullptr);
         grid.add_pad_to_grid(b, pad);
       },
       tp.serial);
@@ -144,7 +140,7 @@ void grid_to_particles(ParticleSet& p, SparseGrid& grid, const TransferParams& t
         GridNode* pad = thread_pad();
         grid.copy_grid_to_pad(b, pad);
         if (has_bulk(grid, tp, b)) with_scheme(tp, b, pad, block);
-        if (tp.others) tp.others(b, pad);
+        if (tp.others) tp.others(b, pad, nullptr);
       },
       tp.serial);
 }

@@ -23,12 +23,11 @@ struct TransferParams {
   /// particles); bulk particle q is binned as first_bulk + q.
   std::uint32_t first_bulk = 0;
   /// Called for every particle block after its bulk particles, with the block's padded
-  /// buffer, to scatter (P2G) or gather (G2P) the other points of the block.
-  std::function<void(std::size_t block, GridNode* buf)> others;
-  /// P2G, where set: in place of `others` for a block without bulk particles. Its buffer
-  /// is all 0 on entry, and it grows `box` to cover every node it writes (only those are
-  /// added to the grid and zeroed again).
-  std::function<void(std::size_t block, GridNode* buf, PadBox& box)> others_boxed;
+  /// buffer, to scatter (P2G) or gather (G2P) the other points of the block. P2G passes a
+  /// box for a block without bulk particles: its buffer is then all 0 on entry, and
+  /// `others` grows the box to cover every node it writes (only those are added to the
+  /// grid, and zeroed again). Elsewhere box is null.
+  std::function<void(std::size_t block, GridNode* buf, PadBox* box)> others;
 };
 
 /// P2G: writes grid mass and momentum including dt * internal force (grid must be binned).

@@ -12,7 +12,7 @@ void G2pStage::run(StepContext& c) {
   TransferParams tp = c.transfer_params();
   const Real dt = tp.dt;
   if (!c.grid_shells.empty())
-    tp.others = [&c, dt](std::size_t b, GridNode* buf) {
+    tp.others = [&c, dt](std::size_t b, GridNode* buf, PadBox*) {
       shell_g2p_block(c.grid, c.shell_table, c.grid_shells, dt, b, buf);
     };
   if (c.scene.shot.shell_guard) {

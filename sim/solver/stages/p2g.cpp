@@ -15,14 +15,10 @@ void P2gStage::run(StepContext& c) {
   FoldHeights* heights = c.shell_fields.active()
                              ? c.shell_fields.begin_p2g(c.grid, c.grid_shells, c.opt.serial)
                              : nullptr;
-  if (!c.grid_shells.empty()) {
-    tp.others = [&c, dt, heights](std::size_t b, GridNode* buf) {
-      shell_p2g_block(c.grid, c.shell_table, c.grid_shells, dt, b, buf, heights);
+  if (!c.grid_shells.empty())
+    tp.others = [&c, dt, heights](std::size_t b, GridNode* buf, PadBox* box) {
+      shell_p2g_block(c.grid, c.shell_table, c.grid_shells, dt, b, buf, heights, box);
     };
-    tp.others_boxed = [&c, dt, heights](std::size_t b, GridNode* buf, PadBox& box) {
-      shell_p2g_block(c.grid, c.shell_table, c.grid_shells, dt, b, buf, heights, &box);
-    };
-  }
   particles_to_grid(c.particles, c.grid, tp);
   if (c.shell_fields.active())
     c.shell_fields.p2g(c.grid, c.grid_shells, dt, &c.particles, tp.first_bulk, c.opt.serial);

@@ -194,10 +194,11 @@ TEST_CASE("contact grid forces sum to zero (momentum)", "[contact]") {
 
 TEST_CASE("P2G of blocks of shell points alone adds only the nodes they reach, with the same bits",
           "[contact]") {
-  // The shells' P2G with others_boxed (a clean buffer per thread, only the box of the
-  // nodes the points reached added to the grid, and zeroed again) against `others` alone
-  // (the whole padded buffer added): every grid node the same, bit for bit. The sheet
-  // is tilted, moving and has forces, so that momentum and the affine term are not 0.
+  // particles_to_grid on blocks without bulk particles (a clean buffer per thread, only
+  // the box of the nodes the points reached added to the grid, and zeroed again) against
+  // the whole padded buffer of each block added, colour by colour: every grid node the
+  // same, bit for bit. The sheet is tilted, moving and has forces, so that momentum and
+  // the affine term are not 0.
   Rig rig(3);
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -218,19 +219,27 @@ TEST_CASE("P2G of blocks of shell points alone adds only the nodes they reach, w
     tp.stress = false;
     tp.serial = true;
     tp.first_bulk = static_cast<std::uint32_t>(rig.table.size());
-    tp.others = [&](std::size_t b, GridNode* buf) {
-      shell_p2g_block(grid, rig.table, rig.shells, tp.dt, b, buf);
-    };
-    if (boxed)
-      tp.others_boxed = [&](std::size_t b, GridNode* buf, PadBox& box) {
-        shell_p2g_block(grid, rig.table, rig.shells, tp.dt, b, buf, nullptr, &box);
-        CHECK(!box.empty());
+    if (boxed) {
+      tp.others = [&](std::size_t b, GridNode* buf, PadBox* box) {
+        REQUIRE(box);
+        shell_p2g_block(grid, rig.table, rig.shells, tp.dt, b, buf, nullptr, box);
+        CHECK(!box->empty());
         int volume = 1;
-        for (int a = 0; a < 3; ++a) volume *= box.hi[a] - box.lo[a];
+        for (int a = 0; a < 3; ++a) volume *= box->hi[a] - box->lo[a];
         partial += volume < kPadNodes;
       };
-    ParticleSet none;
-    particles_to_grid(none, grid, tp);
+      ParticleSet none;
+      particles_to_grid(none, grid, tp);
+    } else {
+      grid.for_each_block_by_colour(
+          [&](std::size_t b) {
+            std::array<GridNode, kPadNodes> pad{};
+            shell_p2g_block(grid, rig.table, rig.shells, tp.dt, b, pad.data());
+            grid.add_pad_to_grid(b, pad.data());
+          },
+          true);
+      grid.zero_unset_blocks(true);
+    }
     runs.push_back(grid.gblock_nodes);
   }
   REQUIRE(runs[0].size() == runs[1].size());

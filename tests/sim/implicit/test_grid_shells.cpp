@@ -97,8 +97,8 @@ sources:
     tp.models = &solver->models();
     tp.densities = &solver->densities();
     tp.first_bulk = static_cast<std::uint32_t>(table.size());
-    tp.others = [this](std::size_t b, GridNode* buf) {
-      shell_p2g_block(grid, table, shells, Real(0.01), b, buf);
+    tp.others = [this](std::size_t b, GridNode* buf, PadBox* box) {
+      shell_p2g_block(grid, table, shells, Real(0.01), b, buf, nullptr, box);
     };
     particles_to_grid(p, grid, tp);
     for (const MaterialDesc& m : scene.materials)

@@ -62,7 +62,7 @@ TEST_CASE("P2G then G2P conserves mass, linear and angular momentum", "[transfer
     grid.setup(1.0 / 64, Vec3d::Zero());
     std::vector<ConstitutiveModel> models(1);
     std::vector<Real> rho{1000};
-    TransferParams tp{0, mls, false, false, &models, &rho, 0, {}, {}};
+    TransferParams tp{0, mls, false, false, &models, &rho, 0, {}};
     double m = 0;
     Vec3d mom = Vec3d::Zero();
     for (std::size_t i = 0; i < p.size(); ++i) {
@@ -97,7 +97,7 @@ TEST_CASE("P2G without C loses angular momentum (the APIC check can fail)", "[tr
   grid.setup(1.0 / 64, Vec3d::Zero());
   std::vector<ConstitutiveModel> models(1);
   std::vector<Real> rho{1000};
-  TransferParams tp{0, false, false, false, &models, &rho, 0, {}, {}};
+  TransferParams tp{0, false, false, false, &models, &rho, 0, {}};
   grid.bin(p.x);
   particles_to_grid(p, grid, tp);
   const Totals t1 = grid_totals(grid, false);
@@ -119,8 +119,8 @@ TEST_CASE("transfers are bit-identical serial and parallel", "[transfer][determi
   ga.setup(1.0 / 64, Vec3d::Zero());
   gb.setup(1.0 / 64, Vec3d::Zero());
   for (int step = 0; step < 3; ++step) {
-    TransferParams ts{1e-4f, false, true, true, &models, &rho, 0, {}, {}};
-    TransferParams tpar{1e-4f, false, false, true, &models, &rho, 0, {}, {}};
+    TransferParams ts{1e-4f, false, true, true, &models, &rho, 0, {}};
+    TransferParams tpar{1e-4f, false, false, true, &models, &rho, 0, {}};
     ga.bin(a.x, true);
     particles_to_grid(a, ga, ts);
     momentum_to_velocity(ga);
@@ -163,7 +163,7 @@ TEST_CASE("a re-binned grid's nodes are those of a fresh grid", "[transfer][grid
   std::vector<ConstitutiveModel> models(1);
   models[0] = ConstitutiveModel::from_desc(MaterialDesc{});
   std::vector<Real> rho{1000};
-  const TransferParams tp{1e-4f, false, false, true, &models, &rho, 0, {}, {}};
+  const TransferParams tp{1e-4f, false, false, true, &models, &rho, 0, {}};
   ParticleSet a = random_particles(20000, 3), b = random_particles(5000, 4);
   for (Vec3& x : b.x) x = Vec3(x[0] * Real(0.5), x[1], x[2] * Real(1.2));  // other blocks
   SparseGrid g, fresh;
