@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <exception>
 
+#include "app/batch_command.h"
 #include "app/commands.h"
 #include "io/user_error.h"
 #include "sim/core/check.h"
@@ -131,6 +132,9 @@ int main(int argc, char** argv) {
                            "folder of the runs (default out/converge)");
   converge_cmd->add_flag("--keep-runs", converge.keep_runs, "keep every run's caches");
 
+  BatchArgs batch;
+  CLI::App* batch_cmd = add_batch_subcommand(app, batch);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -143,6 +147,7 @@ int main(int argc, char** argv) {
     if (*render_cmd) return render_command(render);
     if (*study_cmd) return study_command(study);
     if (*converge_cmd) return converge_command(converge);
+    if (*batch_cmd) return batch_command(*batch_cmd, batch);
   } catch (const UserError& e) {
     std::fprintf(stderr, "\nerror: %s\n", e.what());
     return kExitUserError;

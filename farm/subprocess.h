@@ -1,0 +1,45 @@
+// Child processes for the farm: the engines start `shellmpm batch task`, a task starts
+// `shellmpm run` or `shellmpm render`, the Slurm engine runs sbatch, scontrol, sinfo and
+// squeue. POSIX fork/exec, no shell in between (arguments are never re-parsed).
+#pragma once
+#include <sys/types.h>
+
+#include <string>
+#include <vector>
+
+namespace shellmpm {
+
+/// This program's own executable (/proc/self/exe), so children run the same build.
+std::string self_executable();
+
+/// The full path of `name` on PATH (or `name` itself when it holds a '/' and exists), or
+/// "" when there is none.
+std::string find_program(const std::string& name);
+
+/// Starts argv[0] (a path) with argv. Its stdout and stderr are appended to `log` (created
+/// with its folder), or inherited when `log` is empty. `env` ("NAME=value") are added to its
+/// environment. SIGTERM and SIGINT are restored to their defaults in the child, which gets a
+/// process group of its own (signals reach it through the parent).
+/// @throws std::system_error when fork fails or the log cannot be opened.
+pid_t spawn_process(const std::vector<std::string>& argv, const std::string& log,
+                    const std::vector<std::string>& env = {});
+
+/// Waits for `pid`. Returns its exit code, 128 + the signal when a signal ended it, or
+/// -1 when `nohang` and it is still running. A failed exec exits 127.
+int wait_process(pid_t pid, bool nohang);
+
+struct CommandOutput {
+  int code = -1;       ///< exit code (128 + signal when killed; 127 when it could not start)
+  std::string output;  ///< stdout and stderr together
+};
+
+/// Runs argv to completion, capturing its output; killed (SIGKILL) after `timeout_s`.
+CommandOutput run_capture(const std::vector<std::string>& argv, double timeout_s = 60);
+
+/// The short host name (`hostname -s`).
+std::string short_hostname();
+
+/// The cores this process may run on (sched_getaffinity), at least 1.
+int available_cores();
+
+}  // namespace shellmpm
