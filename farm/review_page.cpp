@@ -76,21 +76,27 @@ std::string number_cell(const std::string& text) {
 const char* kStyle = R"(body{font-family:sans-serif;margin:16px;background:#1e1e1e;color:#ddd}
 table{border-collapse:collapse}td,th{border:1px solid #555;padding:4px 6px;vertical-align:top;
 font-size:13px}th{cursor:pointer;background:#333;position:sticky;top:0}th:hover{background:#444}
-img.sheet{max-width:360px;display:block}video{max-width:360px;display:block}
+img.sheet{max-width:480px;display:block}video{max-width:360px;display:block}
+tbody.task{border-top:3px solid #777}.media{display:flex;gap:12px;align-items:flex-start}
 .failed{color:#f66}.done{color:#6c6}.none{color:#888;font-style:italic})";
 
-const char* kScript = R"(function sortBy(col){const tb=document.querySelector('#wedges tbody');
-const rows=[...tb.rows];const th=document.querySelectorAll('#wedges th')[col];
-const dir=th.dataset.dir==='asc'?-1:1;document.querySelectorAll('#wedges th').forEach(h=>h.dataset.dir='');
-th.dataset.dir=dir>0?'asc':'desc';rows.sort((a,b)=>{const x=a.cells[col].dataset.v,y=b.cells[col].dataset.v;
-const nx=parseFloat(x),ny=parseFloat(y);if(!isNaN(nx)&&!isNaN(ny)&&String(nx)!=='NaN')return dir*(nx-ny);
-return dir*String(x).localeCompare(String(y));});rows.forEach(r=>tb.appendChild(r));}
+const char* kScript = R"(function sortBy(col){const table=document.getElementById('wedges');
+const bodies=[...table.tBodies];const th=table.tHead.rows[0].cells[col];
+const dir=th.dataset.dir==='asc'?-1:1;[...table.tHead.rows[0].cells].forEach(h=>h.dataset.dir='');
+th.dataset.dir=dir>0?'asc':'desc';const key=b=>b.rows[0].cells[col].dataset.v;
+bodies.sort((a,b)=>{const x=key(a),y=key(b);const nx=Number(x),ny=Number(y);
+if(x!==''&&y!==''&&!isNaN(nx)&&!isNaN(ny))return dir*(nx-ny);return dir*String(x).localeCompare(String(y));});
+bodies.forEach(b=>table.appendChild(b));}
 window.addEventListener('load',()=>{const imgs=[...document.images];
 document.body.dataset.images=imgs.length;document.body.dataset.loaded=imgs.filter(i=>i.complete&&i.naturalWidth>0).length;
+document.body.dataset.tasks=document.querySelectorAll('tbody.task').length;
 document.getElementById('loadstate').textContent='images: '+document.body.dataset.loaded+' of '+imgs.length+' loaded';});)";
 
-std::string media_cells(const BatchTask& t, double max_movie_bytes) {
-  std::string s = "<td>";
+/// The contact sheet, the movie and the plot, side by side.
+std::string media_row(const WedgeRow& r, std::size_t columns, double max_movie_bytes) {
+  const BatchTask& t = *r.task;
+  std::string s = "<tr class=\"media\"><td colspan=\"" + std::to_string(columns) +
+                  "\"><div class=\"media\"><div>";
   const std::string still = still_image(t);
   if (!still.empty())
     s += "<img class=\"sheet\" alt=\"" + html_escape(t.id()) + "\" src=\"" +
@@ -108,7 +114,7 @@ std::string media_cells(const BatchTask& t, double max_movie_bytes) {
   } else {
     s += "<span class=\"none\">no movie</span>";
   }
-  return s + "</td>";
+  return s + "</div><div>" + stats_plot_svg(r.frames) + "</div></div></td></tr>\n";
 }
 
 }  // namespace
@@ -179,10 +185,10 @@ std::string review_page_html(const BatchSpec& b, const WedgeTable& t, double max
   cols.insert(cols.end(), {"integrity"});
   for (std::size_t i = 0; i < cols.size(); ++i)
     h += "<th onclick=\"sortBy(" + std::to_string(i) + ")\">" + html_escape(cols[i]) + "</th>";
-  h += "<th>contact sheet</th><th>movie</th><th>per-frame statistics</th></tr></thead><tbody>\n";
+  h += "</tr></thead>\n";
   for (const WedgeRow& r : t.rows) {
     const BatchTask& task = *r.task;
-    h += "<tr class=\"task\" data-task=\"" + std::to_string(task.index) + "\">";
+    h += "<tbody class=\"task\" data-task=\"" + std::to_string(task.index) + "\"><tr>";
     h += number_cell(std::to_string(task.index)) + number_cell(task.shot) + number_cell(task.wedge);
     for (const std::string& v : r.values) h += number_cell(v);
     h += "<td data-v=\"" + r.state + "\" class=\"" + r.state + "\">" + r.state + "</td>";
@@ -193,10 +199,9 @@ std::string review_page_html(const BatchSpec& b, const WedgeTable& t, double max
     h += "<td data-v=\"" + html_escape(r.integrity) + "\" class=\"" +
          (r.integrity.rfind("failed", 0) == 0 ? "failed" : "") + "\">" + html_escape(r.integrity) +
          "</td>";
-    h += media_cells(task, max_movie_bytes);
-    h += "<td>" + stats_plot_svg(r.frames) + "</td></tr>\n";
+    h += "</tr>\n" + media_row(r, cols.size(), max_movie_bytes) + "</tbody>\n";
   }
-  h += "</tbody></table>\n</body></html>\n";
+  h += "</table>\n</body></html>\n";
   return h;
 }
 

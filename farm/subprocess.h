@@ -7,10 +7,9 @@
 #include <string>
 #include <vector>
 
-namespace shellmpm {
+#include "io/study/child_run.h"  // self_executable(): children run this same build
 
-/// This program's own executable (/proc/self/exe), so children run the same build.
-std::string self_executable();
+namespace shellmpm {
 
 /// The full path of `name` on PATH (or `name` itself when it holds a '/' and exists), or
 /// "" when there is none.

@@ -41,6 +41,7 @@ double fold_frames(const nlohmann::json& frames, const FigureDef& d) {
   for (const nlohmann::json& f : frames) {
     if (!f.contains(d.key) || !f[d.key].is_number()) continue;
     const double x = f[d.key].get<double>();
+    if (d.fold == Fold::Min && x <= 0) continue;  // frame 1 takes no step: dt_min 0
     if (std::isnan(acc))
       acc = x;
     else if (d.fold == Fold::Max)
