@@ -30,6 +30,35 @@ std::string StatusRow::state() const {
   return scheduler.empty() ? "pending" : "queued";
 }
 
+namespace {
+
+/// squeue's lines for job `job` (one per array task), "STATE (REASON)" by task index,
+/// prefixed with `prefix`, merged into `view`. False when squeue fails.
+bool add_squeue(const std::string& job, const std::string& prefix, std::map<int, std::string>& view,
+                std::string* note) {
+  // -r: one line per array task, pending ones too.
+  const CommandOutput q = run_capture({"squeue", "-h", "-r", "-j", job, "-o", "%i|%T|%r"}, 20);
+  if (q.code != 0) {
+    if (note) *note = "squeue failed (" + q.output.substr(0, q.output.find('\n')) + ")";
+    return false;
+  }
+  std::istringstream lines(q.output);
+  std::string line;
+  while (std::getline(lines, line)) {
+    const std::size_t a = line.find('|'), c = line.rfind('|');
+    if (a == std::string::npos || c == a) continue;
+    const int index = array_index(line.substr(0, a), job);
+    if (index < 0) continue;
+    const std::string reason = line.substr(c + 1);
+    std::string& v = view[index];
+    v += (v.empty() ? "" : "; ") + prefix + line.substr(a + 1, c - a - 1) +
+         (reason == "None" ? "" : " (" + reason + ")");
+  }
+  return true;
+}
+
+}  // namespace
+
 std::map<int, std::string> squeue_view(const BatchSpec& b, std::string* note) {
   std::map<int, std::string> view;
   std::ifstream in(farm_dir(b) + "/slurm/submit.json", std::ios::binary);
@@ -43,23 +72,14 @@ std::map<int, std::string> squeue_view(const BatchSpec& b, std::string* note) {
     if (note) *note = "squeue is not on PATH: the scheduler's view is left out";
     return view;
   }
-  // -r: one line per array task, pending ones too.
-  const CommandOutput q = run_capture({"squeue", "-h", "-r", "-j", job, "-o", "%i|%T|%r"}, 20);
-  if (q.code != 0) {
-    if (note) *note = "squeue failed (" + q.output.substr(0, q.output.find('\n')) + ")";
-    return view;
+  if (!add_squeue(job, "", view, note)) return view;
+  std::string jobs = "array job " + job;
+  if (j.contains("preview_job")) {
+    const std::string pv = j["preview_job"].get<std::string>();
+    if (!add_squeue(pv, "preview ", view, note)) return view;
+    jobs += ", preview array " + pv;
   }
-  std::istringstream lines(q.output);
-  std::string line;
-  while (std::getline(lines, line)) {
-    const std::size_t a = line.find('|'), c = line.rfind('|');
-    if (a == std::string::npos || c == a) continue;
-    const int index = array_index(line.substr(0, a), job);
-    if (index < 0) continue;
-    const std::string reason = line.substr(c + 1);
-    view[index] = line.substr(a + 1, c - a - 1) + (reason == "None" ? "" : " (" + reason + ")");
-  }
-  if (note) *note = "scheduler: squeue, array job " + job;
+  if (note) *note = "scheduler: squeue, " + jobs;
   return view;
 }
 

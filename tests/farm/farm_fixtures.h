@@ -10,8 +10,8 @@ namespace shellmpm_test {
 /// Writes the tiny jelly scene (240 fps, `frames` frames, a checkpoint every frame) as
 /// DIR/jelly.yaml and returns its path.
 inline std::string write_jelly(const TempDir& d, int frames) {
-  return d.write("jelly.yaml", tiny_jelly_scene(frames, d.file("scene_default_out"),
-                                                "  checkpoint_every: 1\n"));
+  return d.write("jelly.yaml",
+                 tiny_jelly_scene(frames, d.file("scene_default_out"), "  checkpoint_every: 1\n"));
 }
 
 /// A batch of 2 shots x 2 wedge members over DIR/jelly.yaml (write_jelly first), output
@@ -20,11 +20,12 @@ inline std::string two_by_two_batch(int frames, const std::string& extra_shot = 
                                     const std::string& extra = "") {
   const std::string f = "    frames: [1, " + std::to_string(frames) + "]\n";
   return "version: 1\nname: tiny\noutput: out\nshots:\n"
-         "  - name: soft\n    scene: jelly.yaml\n" + f +
-         "    set:\n      materials[0].youngs_modulus: 5000\n    wedge: drop\n" + extra_shot +
+         "  - name: soft\n    scene: jelly.yaml\n" +
+         f + "    set:\n      materials[0].youngs_modulus: 5000\n    wedge: drop\n" + extra_shot +
          "  - name: stiff\n    scene: jelly.yaml\n" + f +
          "    set:\n      materials[0].youngs_modulus: 20000\n    wedge: drop\n" + extra_shot +
-         "wedges:\n  - name: drop\n    product:\n      sources[0].velocity: [[0, 0, 0], [0, -1, 0]]\n" +
+         "wedges:\n  - name: drop\n    product:\n      sources[0].velocity: [[0, 0, 0], [0, -1, "
+         "0]]\n" +
          extra;
 }
 

@@ -19,8 +19,8 @@ using namespace shellmpm_test;
 
 namespace {
 
-const char* const kIds[] = {"soft/velocity-0_0_0", "soft/velocity-0_-1_0",
-                            "stiff/velocity-0_0_0", "stiff/velocity-0_-1_0"};
+const char* const kIds[] = {"soft/velocity-0_0_0", "soft/velocity-0_-1_0", "stiff/velocity-0_0_0",
+                            "stiff/velocity-0_-1_0"};
 
 int count(const std::string& s, const std::string& what) {
   int n = 0;
@@ -89,7 +89,8 @@ TEST_CASE("batch: plan, run two at a time, skip what is done, task, status and c
   const CmdResult again = run_shellmpm("batch run " + batch);
   INFO(again.output);
   CHECK(again.code == 0);
-  CHECK(again.output.find("nothing to do: all 4 tasks of batch tiny are done") != std::string::npos);
+  CHECK(again.output.find("nothing to do: all 4 tasks of batch tiny are done") !=
+        std::string::npos);
   const CmdResult one = run_shellmpm("batch task " + batch + " 2");
   CHECK(one.code == 0);
   CHECK(one.output.find("task 2 (stiff/velocity-0_0_0): already done (3 frames") !=
@@ -142,9 +143,10 @@ TEST_CASE("batch: a batch whose scenes fail check is refused and nothing is writ
           "[farm][batch]") {
   TempDir d("farm_refuse");
   write_jelly(d, 2);
-  const std::string batch = d.write(
-      "b.yaml", "version: 1\noutput: out\nshots:\n  - name: a\n    scene: jelly.yaml\n"
-                "  - name: b\n    scene: jelly.yaml\n    set:\n      shot.dx: -0.1\n");
+  const std::string batch =
+      d.write("b.yaml",
+              "version: 1\noutput: out\nshots:\n  - name: a\n    scene: jelly.yaml\n"
+              "  - name: b\n    scene: jelly.yaml\n    set:\n      shot.dx: -0.1\n");
   for (const char* cmd : {"plan", "run", "submit --dry-run"}) {
     const CmdResult r = run_shellmpm(std::string("batch ") + cmd + " " + batch);
     INFO(cmd << ": " << r.output);
@@ -153,7 +155,8 @@ TEST_CASE("batch: a batch whose scenes fail check is refused and nothing is writ
     CHECK(r.output.find("(task 1, b/base)") != std::string::npos);
   }
   CHECK_FALSE(fs::exists(d.file("out")));
-  const CmdResult unknown = run_shellmpm("batch plan " + d.write("u.yaml", "version: 1\nshot: 1\n"));
+  const CmdResult unknown =
+      run_shellmpm("batch plan " + d.write("u.yaml", "version: 1\nshot: 1\n"));
   CHECK(unknown.code == 2);
   CHECK(unknown.output.find(d.file("u.yaml") + ":2: shot: unknown key 'shot'") !=
         std::string::npos);
@@ -172,7 +175,8 @@ TEST_CASE("batch: a failing task does not stop the others and is reported with i
   CHECK(r.code == 1);
   CHECK(r.output.find("3 done, 0 previews, 0 skipped (done before), 1 failed") !=
         std::string::npos);
-  CHECK(r.output.find("error: task 1 (soft/velocity-0_-1_0) failed with exit") != std::string::npos);
+  CHECK(r.output.find("error: task 1 (soft/velocity-0_-1_0) failed with exit") !=
+        std::string::npos);
   CHECK(r.output.find(d.file("out/_farm/logs/task.0001.log")) != std::string::npos);
   CHECK(r.output.find("    | == task 1 (soft/velocity-0_-1_0) attempt 1") != std::string::npos);
   const CmdResult st = run_shellmpm("batch status " + batch);
@@ -189,8 +193,7 @@ TEST_CASE(
   const std::string batch = d.write("b.yaml", two_by_two_batch(24));
   const Child c = spawn_shellmpm({"batch", "run", batch, "--slots", "2"}, d.file("run.log"));
   REQUIRE(c.pid > 0);
-  const bool started =
-      wait_for_file(d.file("out/soft/velocity-0_0_0/checkpoint.0003.bin"), 120);
+  const bool started = wait_for_file(d.file("out/soft/velocity-0_0_0/checkpoint.0003.bin"), 120);
   kill(c.pid, SIGTERM);
   const CmdResult stopped = wait_child(c);
   INFO(stopped.output);

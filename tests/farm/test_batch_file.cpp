@@ -132,8 +132,9 @@ TEST_CASE("batch file: bad input is refused at its file, line and key", "[farm][
             "frames, set, wedge, preview)");
   CHECK(error_of(d, head + "    frames: [3, 1]\n") ==
         f + ":5: shots[0].frames: the last frame (1) is before the first (3)");
-  CHECK(error_of(d, head + "    wedge: nope\n").find(f + ":3: shots[0].wedge: no wedge named "
-                                                       "'nope'") == 0);
+  CHECK(error_of(d, head + "    wedge: nope\n")
+            .find(f + ":3: shots[0].wedge: no wedge named "
+                      "'nope'") == 0);
   CHECK(error_of(d, "version: 1\nshots:\n  - name: a\n    scene: missing.yaml\n") ==
         f + ":4: shots[0].scene: no scene file '" + d.file("missing.yaml") + "'");
   CHECK(error_of(d, "version: 1\nshots:\n  - name: ../up\n    scene: jelly.yaml\n")

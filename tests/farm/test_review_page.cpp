@@ -47,8 +47,10 @@ TEST_CASE("review page: headless Chromium loads every image and shows every task
   CHECK(html.find("src=\"data:image/png;base64,") != std::string::npos);
   CHECK(html.find("src=\"data:video/mp4;base64,") != std::string::npos);
 
-  const std::string flags = " --headless --no-sandbox --disable-gpu --no-first-run "
-                            "--user-data-dir=" + d.file("chromium") + " --window-size=1400,1200 ";
+  const std::string flags =
+      " --headless --no-sandbox --disable-gpu --no-first-run "
+      "--user-data-dir=" +
+      d.file("chromium") + " --window-size=1400,1200 ";
   const std::string shot = d.file("shot.png");
   const CmdResult s =
       run_command("timeout 120 " + chromium + flags + "--screenshot=" + shot + " file://" + page);
@@ -56,11 +58,12 @@ TEST_CASE("review page: headless Chromium loads every image and shows every task
   REQUIRE(fs::exists(shot));
   CHECK(fs::file_size(shot) > 20000);  // a rendered page, not a blank one
   // The page after its load handler ran: it counts the images that decoded.
-  const CmdResult dom = run_command("timeout 120 " + chromium + flags + "--dump-dom file://" + page +
-                                    " 2>/dev/null");
+  const CmdResult dom =
+      run_command("timeout 120 " + chromium + flags + "--dump-dom file://" + page + " 2>/dev/null");
   std::smatch m;
-  const std::regex body("<body data-images=\"([0-9]+)\" data-loaded=\"([0-9]+)\" "
-                        "data-tasks=\"([0-9]+)\">");
+  const std::regex body(
+      "<body data-images=\"([0-9]+)\" data-loaded=\"([0-9]+)\" "
+      "data-tasks=\"([0-9]+)\">");
   REQUIRE(std::regex_search(dom.output, m, body));
   CHECK(m[1] == "4");  // four contact sheets
   CHECK(m[2] == m[1]);

@@ -57,25 +57,26 @@ nlohmann::json status_of(const std::string& batch) {
   return j.is_discarded() ? nlohmann::json() : j;
 }
 
-/// Polls until `pred(status json)` holds or `seconds` pass.
+/// Polls until `pred()` holds (every 50 ms) or `seconds` pass.
 template <class Pred>
-bool wait_until(const std::string& batch, double seconds, Pred pred) {
+bool wait_until(double seconds, Pred pred) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (std::chrono::steady_clock::now() < end) {
-    const nlohmann::json s = status_of(batch);
-    if (!s.is_null() && pred(s)) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    if (pred()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   return false;
 }
 
-/// Task `i` is running and has written frame `frame`'s checkpoint.
-bool running_past(const nlohmann::json& s, const std::string& out, int i, int frame) {
-  const auto& t = s["tasks"][i];
-  char ck[64];
+/// Task `i` (folder OUT/ID) is running (its status file says so) and has written frame
+/// `frame`'s checkpoint.
+bool running_past(const TempDir& d, int i, const std::string& id, int frame) {
+  char st[64], ck[64];
+  std::snprintf(st, sizeof st, "out/_farm/status/%04d.json", i);
   std::snprintf(ck, sizeof ck, "/checkpoint.%04d.bin", frame);
-  return t["state"] == "running" &&
-         fs::exists(out + "/" + t["id"].get<std::string>() + ck);
+  const nlohmann::json s = nlohmann::json::parse(read_text(d.file(st)), nullptr, false);
+  return !s.is_discarded() && s.contains("sim") && s["sim"]["state"] == "running" &&
+         fs::exists(d.file("out/" + id + ck));
 }
 
 }  // namespace
@@ -90,9 +91,10 @@ TEST_CASE(
     return;
   }
   TempDir d("farm_slurm");
-  write_jelly(d, 30);
+  constexpr int kFrames = 80;  // about 3 s a task here: time to requeue and preempt
+  write_jelly(d, kFrames);
   const std::string preview = "    preview: {size: 96x64, renderer: raster}\n";
-  const std::string batch = d.write("b.yaml", two_by_two_batch(30, preview));
+  const std::string batch = d.write("b.yaml", two_by_two_batch(kFrames, preview));
   fs::create_directories(d.file("slurm"));
   LocalSlurm slurm(d.file("slurm"));
   INFO(slurm.log);
@@ -110,16 +112,21 @@ TEST_CASE(
   const std::string out = d.file("out");
 
   // Requeue task 0 once it is running past its third frame.
-  REQUIRE(wait_until(batch, 120, [&](const nlohmann::json& s) { return running_past(s, out, 0, 3); }));
-  CHECK(run_command("scontrol requeue " + job + "_0").code == 0);
+  REQUIRE(wait_until(120, [&] { return running_past(d, 0, "soft/velocity-0_0_0", 3); }));
+  const CmdResult requeue = run_command("scontrol requeue " + job + "_0");
+  INFO(requeue.output);
+  CHECK(requeue.code == 0);
   // Preempt task 1: a job in "high" wants both cores.
-  REQUIRE(wait_until(batch, 120, [&](const nlohmann::json& s) { return running_past(s, out, 1, 3); }));
+  REQUIRE(wait_until(120, [&] { return running_past(d, 1, "soft/velocity-0_-1_0", 3); }));
   const CmdResult high =
       run_command("sbatch --parsable -p high -c 2 --mem 10M -o /dev/null --wrap 'sleep 2'");
   INFO(high.output);
   CHECK(high.code == 0);
 
-  const bool finished = wait_until(batch, 300, [](const nlohmann::json& s) {
+  const bool finished = wait_until(300, [&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));  // status runs squeue
+    const nlohmann::json s = status_of(batch);
+    if (s.is_null()) return false;
     for (const auto& t : s["tasks"])
       if (t["state"] != "done" || t["preview"] != "done") return false;
     return true;
@@ -153,15 +160,15 @@ TEST_CASE(
   REQUIRE(run_shellmpm("batch collect -q " + batch).code == 0);
   const nlohmann::json wj = nlohmann::json::parse(read_text(d.file("out/wedge_table.json")));
   REQUIRE(wj["tasks"].size() == 4);
-  for (const auto& t : wj["tasks"]) CHECK(t["frames_done"] == 30);
+  for (const auto& t : wj["tasks"]) CHECK(t["frames_done"] == kFrames);
 
   // The same batch by the local engine, without faults: every cache byte-identical.
-  std::string ref_text = two_by_two_batch(30);
+  std::string ref_text = two_by_two_batch(kFrames);
   ref_text.replace(ref_text.find("output: out"), 11, "output: ref");
   REQUIRE(run_shellmpm("batch run -q " + d.write("ref.yaml", ref_text)).code == 0);
   for (const auto& t : s["tasks"]) {
     const std::string id = t["id"];
-    for (int f = 1; f <= 30; ++f) {
+    for (int f = 1; f <= kFrames; ++f) {
       char name[64];
       std::snprintf(name, sizeof name, "/density.%04d.vdb", f);
       INFO(id << name);

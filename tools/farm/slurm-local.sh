@@ -35,8 +35,8 @@ start)
   chmod 755 "$root"
   chown munge:munge "$root/munge"
   chmod 711 "$root/munge"
-  runuser -u munge -- mungekey --create --keyfile="$root/munge/munge.key" >/dev/null 2>&1 ||
-    runuser -u munge -- mungekey -c -k "$root/munge/munge.key"
+  [ -f "$root/munge/munge.key" ] ||
+    runuser -u munge -- mungekey --create --keyfile="$root/munge/munge.key"
   runuser -u munge -- munged --socket="$root/munge/munge.socket.2" \
     --key-file="$root/munge/munge.key" --pid-file="$root/munge/munged.pid" \
     --log-file="$root/munge/munged.log" --seed-file="$root/munge/munged.seed"
