@@ -1,5 +1,8 @@
 #include "farm/batch_status.h"
 
+#include <signal.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -26,6 +29,10 @@ int array_index(const std::string& id, const std::string& job) {
 }  // namespace
 
 std::string StatusRow::state() const {
+  if (status && status->sim.state == TaskState::Running && !scheduler_running() &&
+      status->host == short_hostname() && status->pid > 0 && kill(status->pid, 0) != 0 &&
+      errno == ESRCH)
+    return "lost";  // its process on this machine is gone (killed hard): run it again
   if (status) return word_of_state(status->sim.state);
   return scheduler.empty() ? "pending" : "queued";
 }

@@ -17,8 +17,11 @@ struct StatusRow {
   std::optional<TaskStatus> status;  ///< none: the task has not started
   int frames_done = 0;
   std::string scheduler;  ///< squeue's state and reason ("PENDING (BeginTime)"), or ""
-  /// The state shown: the status file's, or "pending"/"queued" (the scheduler holds it).
+  /// The state shown: the status file's; "pending"/"queued" (the scheduler holds it)
+  /// before it starts; "lost" when it says running but its process on this machine is gone
+  /// (killed with SIGKILL: the next `batch run` resumes it from its checkpoint).
   std::string state() const;
+  bool scheduler_running() const { return scheduler.rfind("RUNNING", 0) == 0; }
 };
 
 /// squeue's view of a submitted batch: task index -> "STATE (REASON)", read from

@@ -1,5 +1,7 @@
 #include "farm/local_engine.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -44,6 +46,11 @@ class LocalEngine {
  public:
   LocalEngine(const BatchSpec& b, const std::vector<BatchTask>& tasks, const LocalRunOptions& o)
       : b_(b), tasks_(tasks), o_(o), tty_(isatty(1) != 0 && !o.quiet) {}
+  ~LocalEngine() {
+    if (lock_fd_ >= 0) ::close(lock_fd_);
+  }
+  LocalEngine(const LocalEngine&) = delete;
+  LocalEngine& operator=(const LocalEngine&) = delete;
 
   int run();
 
@@ -66,6 +73,7 @@ class LocalEngine {
   int skipped_ = 0, done_ = 0, stopped_ = 0, previews_ = 0;
   std::vector<std::pair<int, int>> failed_;  ///< task index, exit code
   int drawn_lines_ = 0;
+  int lock_fd_ = -1;
   double t0_ = 0;
 };
 
@@ -208,6 +216,13 @@ int LocalEngine::run() {
              : b_.farm.threads > 0 ? b_.farm.threads
                                    : std::max(1, cores / slots_);
   write_task_table(b_, tasks_);
+  // One `batch run` of a batch at a time (its tasks would wait for each other's locks).
+  const std::string lock_path = farm_dir(b_) + "/run.lock";
+  lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0 || flock(lock_fd_, LOCK_EX | LOCK_NB) != 0)
+    throw UserError(lock_path, 0, "",
+                    "another `shellmpm batch run` of this batch is running (it holds this "
+                    "lock); `shellmpm batch status` follows it");
   if (!o_.quiet)
     std::printf("batch %s: %d tasks, %zu to run%s, %d at a time with %d thread%s each (%d cores)\n",
                 b_.name.c_str(), n, queue_.size(),

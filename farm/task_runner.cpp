@@ -1,5 +1,9 @@
 #include "farm/task_runner.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -57,6 +61,37 @@ TaskStatus load_status(const BatchSpec& b, const BatchTask& t) {
                         "another name");
   return *s;
 }
+
+/// An exclusive lock on FARM/status/NNNN.lock for as long as it lives: two attempts of one
+/// task never run at once (a requeued attempt starting while the last one still writes its
+/// checkpoint waits for it, up to `wait_s`).
+class TaskLock {
+ public:
+  TaskLock(const BatchSpec& b, int index, double wait_s) {
+    const std::string path =
+        status_path(b, index).substr(0, status_path(b, index).size() - 5) + ".lock";
+    fs::create_directories(fs::path(path).parent_path());
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw UserError(path, 0, "", "cannot open the task's lock file");
+    const double end = unix_now() + wait_s;
+    while (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+      if (unix_now() > end)
+        throw UserError(path, 0, "",
+                        "task " + std::to_string(index) +
+                            " is being run by another process "
+                            "(it holds this lock); not starting a second attempt");
+      usleep(200000);
+    }
+  }
+  ~TaskLock() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  TaskLock(const TaskLock&) = delete;
+  TaskLock& operator=(const TaskLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 /// Runs argv as this task's step, relaying signals; returns its exit code.
 int run_step(const std::vector<std::string>& argv) {
@@ -147,8 +182,10 @@ int run_batch_task(const BatchSpec& b, const std::vector<BatchTask>& tasks, int 
                         std::to_string(tasks.size()) + " (0-" + std::to_string(tasks.size() - 1) +
                         ")");
   const BatchTask& t = tasks[index];
+  const TaskLock lock(b, index, 120);
   TaskStatus st = load_status(b, t);
   st.host = short_hostname();
+  st.pid = static_cast<int>(getpid());
   st.engine = o.engine;
   st.job = o.job;
   if (o.preview) return preview_step(b, t, st, o);

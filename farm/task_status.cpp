@@ -79,6 +79,7 @@ std::optional<TaskStatus> read_task_status(const BatchSpec& b, int index) {
     s.sim = step_of_json(j.at("sim"), path);
     s.preview = step_of_json(j.at("preview"), path);
     s.host = j.value("host", "");
+    s.pid = j.value("pid", 0);
     s.engine = j.value("engine", "");
     s.job = j.value("job", "");
     return s;
@@ -96,6 +97,7 @@ void write_task_status(const BatchSpec& b, const TaskStatus& s) {
   j["sim"] = step_json(s.sim);
   j["preview"] = step_json(s.preview);
   j["host"] = s.host;
+  j["pid"] = s.pid;
   j["engine"] = s.engine;
   j["job"] = s.job;
   const std::string path = status_path(b, s.index);

@@ -31,6 +31,7 @@ struct TaskStatus {
   std::string fingerprint;  ///< task_fingerprint, hex
   StepStatus sim, preview;
   std::string host;    ///< where the last attempt ran
+  int pid = 0;         ///< the `batch task` process of the last attempt, on `host`
   std::string engine;  ///< local, slurm, or what SHELLMPM_FARM_ENGINE says
   std::string job;     ///< the scheduler's id of the last attempt (e.g. 1234_3), if any
   int restarts() const { return sim.attempts > 0 ? sim.attempts - 1 : 0; }
