@@ -131,6 +131,10 @@ std::string status_table(const BatchSpec& b, const std::vector<StatusRow>& rows)
                   wall.c_str(), preview.c_str(), r.scheduler.empty() ? "-" : r.scheduler.c_str());
     s += line;
   }
+  for (const StatusRow& r : rows)
+    if (r.state() == "failed" || r.state() == "lost")
+      s += "task " + std::to_string(r.task->index) + " " + r.state() + ": see " +
+           log_path(b, r.task->index) + "\n";
   s += "batch " + b.name + ": " + std::to_string(rows.size()) + " tasks";
   for (const auto& [state, n] : counts) s += ", " + std::to_string(n) + " " + state;
   return s + "\n";

@@ -94,8 +94,7 @@ class TaskLock {
 };
 
 /// Runs argv as this task's step, relaying signals; returns its exit code.
-int run_step(const std::vector<std::string>& argv) {
-  SignalRelay relay;
+int run_step(const std::vector<std::string>& argv, SignalRelay& relay) {
   if (SignalRelay::pending() != 0) return 128 + SignalRelay::pending();
   const pid_t pid = spawn_process(argv, "");
   relay.add(pid);
@@ -128,7 +127,8 @@ std::string exit_meaning(int code) {
   }
 }
 
-int preview_step(const BatchSpec& b, const BatchTask& t, TaskStatus& st, const TaskRunOptions& o) {
+int preview_step(const BatchSpec& b, const BatchTask& t, TaskStatus& st, const TaskRunOptions& o,
+                 SignalRelay& relay) {
   if (st.sim.state != TaskState::Done)
     throw UserError(b.path, 0, "",
                     "task " + std::to_string(t.index) + " (" + t.id() +
@@ -149,7 +149,7 @@ int preview_step(const BatchSpec& b, const BatchTask& t, TaskStatus& st, const T
               st.preview.attempts, st.host.c_str(), clock_text(start).c_str(),
               joined(argv).c_str());
   std::fflush(stdout);
-  const int code = run_step(argv);
+  const int code = run_step(argv, relay);
   st.preview.last_exit = code;
   st.preview.state = state_after(code);
   st.preview.finished = unix_now();
@@ -182,13 +182,14 @@ int run_batch_task(const BatchSpec& b, const std::vector<BatchTask>& tasks, int 
                         std::to_string(tasks.size()) + " (0-" + std::to_string(tasks.size() - 1) +
                         ")");
   const BatchTask& t = tasks[index];
+  SignalRelay relay;  // from the start: a stop before the run starts is one too
   const TaskLock lock(b, index, 120);
   TaskStatus st = load_status(b, t);
   st.host = short_hostname();
   st.pid = static_cast<int>(getpid());
   st.engine = o.engine;
   st.job = o.job;
-  if (o.preview) return preview_step(b, t, st, o);
+  if (o.preview) return preview_step(b, t, st, o, relay);
   if (st.sim.state == TaskState::Done && !o.force) {
     std::printf("== task %d (%s): already done (%d frames in %s); skipping\n", t.index,
                 t.id().c_str(), frames_done(t), t.output.c_str());
@@ -209,7 +210,7 @@ int run_batch_task(const BatchSpec& b, const std::vector<BatchTask>& tasks, int 
               st.sim.attempts, st.host.c_str(), o.engine.c_str(), o.job.empty() ? "" : " ",
               o.job.c_str(), clock_text(start).c_str(), joined(argv).c_str());
   std::fflush(stdout);
-  const int code = run_step(argv);
+  const int code = run_step(argv, relay);
   add_wedge_to_manifest(t);
   st.sim.last_exit = code;
   st.sim.state = state_after(code);
