@@ -34,14 +34,17 @@ std::string frame_file(const std::string& dir, const char* stem, int frame, cons
   return dir + name;
 }
 
-/// Every density frame and the physics of stats.json (no wall times) of two task folders
-/// are byte-identical.
+/// Every particle cache and density frame (but for the VDB file's random UUID) and the
+/// physics of stats.json (no wall times) of two task folders are byte-identical.
 void check_same_caches(const std::string& a, const std::string& b, int frames) {
   for (int f = 1; f <= frames; ++f) {
     INFO(a << " frame " << f);
-    const std::string x = read_text(frame_file(a, "density", f, "vdb"));
+    const std::string p = read_text(frame_file(a, "particles", f, "ply"));
+    REQUIRE(p.size() > 1000);
+    CHECK(p == read_text(frame_file(b, "particles", f, "ply")));
+    const std::string x = cache_bytes(frame_file(a, "density", f, "vdb"));
     REQUIRE(x.size() > 100);
-    CHECK(x == read_text(frame_file(b, "density", f, "vdb")));
+    CHECK(x == cache_bytes(frame_file(b, "density", f, "vdb")));
   }
   auto physics = [](const std::string& dir) {
     nlohmann::json j = nlohmann::json::parse(read_text(dir + "/stats.json"));
@@ -83,8 +86,8 @@ TEST_CASE("batch: plan, run two at a time, skip what is done, task, status and c
     CHECK(m["wedge"]["values"].contains("sources[0].velocity"));
   }
   // The two wedge members differ, and so do the shots.
-  CHECK(read_text(d.file("out/soft/velocity-0_0_0/density.0003.vdb")) !=
-        read_text(d.file("out/soft/velocity-0_-1_0/density.0003.vdb")));
+  CHECK(read_text(d.file("out/soft/velocity-0_0_0/particles.0003.ply")) !=
+        read_text(d.file("out/soft/velocity-0_-1_0/particles.0003.ply")));
 
   const CmdResult again = run_shellmpm("batch run " + batch);
   INFO(again.output);
@@ -208,7 +211,8 @@ TEST_CASE(
   const CmdResult resumed = run_shellmpm("batch run " + batch + " --slots 2");
   INFO(resumed.output);
   REQUIRE(resumed.code == 0);
-  CHECK(count(resumed.output, ": resume from " + d.file("out/soft/")) == 2);
+  // (A task stopped before its first frame was written has no checkpoint: it starts anew.)
+  CHECK(count(resumed.output, ": resume from " + d.file("out/soft/")) >= 1);
   const nlohmann::json sj =
       nlohmann::json::parse(run_shellmpm("batch status --json " + batch).output);
   CHECK(sj["tasks"][0]["restarts"] == 1);

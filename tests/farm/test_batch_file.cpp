@@ -59,7 +59,7 @@ wedges:
   CHECK(tasks[6].wedge_values.empty());
   CHECK_FALSE(tasks[6].frames_from_batch);
   for (int i = 0; i < 7; ++i) CHECK(tasks[i].index == i);
-  CHECK(tasks[4].output == d.file("out/wedge/a/youngs_modulus-2e4_friction-0.1_velocity-0_-1_0"));
+  CHECK(tasks[4].output == d.file("out/wedge/a/youngs_modulus-2e4_friction-0.5_velocity-0_-1_0"));
   // The shot's set first, then the wedge member's; values keep their YAML text.
   const std::vector<std::string> args = run_arguments(tasks[4]);
   const std::vector<std::string> want = {d.file("jelly.yaml"),
@@ -72,12 +72,12 @@ wedges:
                                          "--set",
                                          "materials[0].youngs_modulus=2e4",
                                          "--set",
-                                         "colliders[0].friction=0.1",
+                                         "colliders[0].friction=0.5",
                                          "--set",
                                          "sources[0].velocity=[0, -1, 0]"};
   CHECK(args == want);
   CHECK(values_text(tasks[4]) ==
-        "materials[0].youngs_modulus=2e4 colliders[0].friction=0.1 sources[0].velocity=[0, -1, 0]");
+        "materials[0].youngs_modulus=2e4 colliders[0].friction=0.5 sources[0].velocity=[0, -1, 0]");
   // The same text expands the same way every time (deterministic indices and folders).
   const std::vector<BatchTask> again = expand_tasks(parse_batch(text, d.file("b.yaml")));
   for (int i = 0; i < 7; ++i) CHECK(again[i].output == tasks[i].output);

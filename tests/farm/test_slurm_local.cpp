@@ -169,12 +169,16 @@ TEST_CASE(
   for (const auto& t : s["tasks"]) {
     const std::string id = t["id"];
     for (int f = 1; f <= kFrames; ++f) {
-      char name[64];
-      std::snprintf(name, sizeof name, "/density.%04d.vdb", f);
-      INFO(id << name);
-      const std::string a = read_text(out + "/" + id + name);
-      REQUIRE(a.size() > 100);
-      CHECK(a == read_text(d.file("ref/") + id + name));
+      char ply[64], vdb[64];
+      std::snprintf(ply, sizeof ply, "/particles.%04d.ply", f);
+      std::snprintf(vdb, sizeof vdb, "/density.%04d.vdb", f);
+      INFO(id << " frame " << f);
+      const std::string a = read_text(out + "/" + id + ply);
+      REQUIRE(a.size() > 1000);
+      CHECK(a == read_text(d.file("ref/") + id + ply));
+      const std::string v = cache_bytes(out + "/" + id + vdb);
+      REQUIRE(v.size() > 100);
+      CHECK(v == cache_bytes(d.file("ref/") + id + vdb));
     }
   }
 }
