@@ -63,6 +63,23 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     in["non_finite"] = r.non_finite;
     in["stretched_edges"] = r.stretched_edges;
     in["max_edge"] = r.max_edge;
+    // Gaps between contact surfaces (integrity_report.h), in metres and in cells.
+    const auto gaps = [&r](const GapSummary& g) {
+      nlohmann::json jg;
+      jg["points"] = g.count;
+      if (g.count) {
+        jg["min"] = g.min;
+        jg["median"] = g.median;
+        if (r.dx > 0) {
+          jg["min_dx"] = g.min / r.dx;
+          jg["median_dx"] = g.median / r.dx;
+        }
+      }
+      return jg;
+    };
+    in["gaps"] = {{"shell_shell", gaps(r.shell_shell)},
+                  {"shell_bulk", gaps(r.shell_bulk)},
+                  {"shell_collider", gaps(r.shell_collider)}};
     nlohmann::json ev = nlohmann::json::array();
     for (const IntegrityEvent& e : r.events) {
       static const char* kinds[] = {"bulk_through_shell", "shell_through_shell", "shells_intersect",

@@ -10,11 +10,15 @@ namespace shellmpm {
 void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* first,
                             const std::vector<Vec3>* first_v, const std::vector<Vec3>& x,
                             const std::vector<Vec3>& v, const std::vector<Collider>& colliders,
-                            double reach, double dt, bool serial) {
+                            double reach, double dt, bool serial,
+                            const std::vector<Real>* first_offset) {
   const std::size_t nb = grid.num_particle_blocks();
   const std::size_t nf = first ? first->size() : 0;
   const std::size_t nk = std::min<std::size_t>(colliders.size(), 32);
   const double dx = grid.dx();
+  double most = 0;  // the largest offset
+  if (first_offset)
+    for (Real o : *first_offset) most = std::max(most, double(o));
   buf_.resize(nb);
   touched_.assign(nb, 0);
   parallel_for_each(
@@ -34,7 +38,8 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
         const double radius = 0.5 * (box.hi - box.lo).norm();
         std::uint32_t near = 0;
         for (std::size_t k = 0; k < nk; ++k)
-          if (colliders[k].bounds().overlaps(box) && colliders[k].phi(centre) <= radius + reach)
+          if (colliders[k].bounds().overlaps(box) &&
+              colliders[k].phi(centre) <= radius + reach + most)
             near |= 1u << k;
         if (!near) return;
         bool touched = false;
@@ -42,9 +47,12 @@ void ColliderReach::compute(const SparseGrid& grid, const std::vector<Vec3>* fir
           const Vec3& p = i < nf ? (*first)[i] : x[i - nf];
           const Vec3d pd = p.cast<double>();
           const Vec3d pe = pd + dt * (i < nf ? (*first_v)[i] : v[i - nf]).cast<double>();
+          // A shell point's contact surface lies its offset (half its contact thickness)
+          // out from it.
+          const double at = i < nf && first_offset ? reach + double((*first_offset)[i]) : reach;
           std::uint32_t bits = 0;
           for (std::size_t k = 0; k < nk; ++k)
-            if (((near >> k) & 1u) && std::min(colliders[k].phi(pd), colliders[k].phi(pe)) <= reach)
+            if (((near >> k) & 1u) && std::min(colliders[k].phi(pd), colliders[k].phi(pe)) <= at)
               bits |= 1u << k;
           if (!bits) return;
           if (!touched) buf.fill(0);

@@ -36,11 +36,13 @@ class ColliderReach {
   /// Marks the nodes of `grid` (binned from the concatenation of `first`, which may be
   /// null, and `x`, as SparseGrid::bin) whose points come within reach [m] of each
   /// collider (begin_step already called) at the start of the step or where their
-  /// velocities (first_v, v, alongside) take them by its end, x + dt v.
+  /// velocities (first_v, v, alongside) take them by its end, x + dt v. first_offset
+  /// (may be null): per point of `first`, how far out its contact surface lies [m] (half a
+  /// shell's contact thickness): it reaches that much further.
   void compute(const SparseGrid& grid, const std::vector<Vec3>* first,
                const std::vector<Vec3>* first_v, const std::vector<Vec3>& x,
                const std::vector<Vec3>& v, const std::vector<Collider>& colliders, double reach,
-               double dt, bool serial);
+               double dt, bool serial, const std::vector<Real>* first_offset = nullptr);
   /// Whether node n of grid block g takes collider k's condition. Colliders past the
   /// 32nd, and every collider before compute, always do.
   bool engaged(std::size_t g, int n, std::size_t k) const {

@@ -11,7 +11,8 @@ namespace {
 constexpr std::size_t kGrain = 4096;
 
 // One point against one collider; returns 1 if moved out from inside, 2 if swept.
-int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr, Vec3& v) {
+int project_point(const Collider& c, double dx, double dt, double offset, bool sweep, Vec3& xr,
+                  Vec3& v) {
   const Vec3d x = xr.cast<double>();
   const Vec3d start = x - dt * v.cast<double>();
   const Vec3d x0 = c.animated() ? c.end_of(start) : start;  // the start, in the end pose's frame
@@ -21,10 +22,10 @@ int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr,
   box.hi = x.cwiseMax(x0).array() + dx;
   if (!c.bounds().overlaps(box)) return 0;
   const double phi = c.phi(x);
-  if (phi < 0) {
+  if (phi < offset) {
     // A hair outside (1e-4 dx), so that float rounding does not leave it inside.
     const Vec3d n = c.normal(x);
-    const Vec3d y = x + (1e-4 * dx - phi) * n;
+    const Vec3d y = x + (1e-4 * dx + offset - phi) * n;
     xr = y.cast<Real>();
     v = c.resolve(y, n, v);
     return 1;
@@ -32,10 +33,10 @@ int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr,
   const int samples = sweep ? static_cast<int>(std::ceil(len / (0.5 * dx))) : 0;
   if (samples < 2) return 0;
   Vec3d last = x0;
-  if (c.phi(x0) < 0) return 0;  // started inside (the grid pushes it out): not a sweep
+  if (c.phi(x0) < offset) return 0;  // started inside (the grid pushes it out): not a sweep
   for (int k = 1; k < samples; ++k) {
     const Vec3d y = x0 + (x - x0) * (static_cast<double>(k) / samples);
-    if (c.phi(y) < 0) {
+    if (c.phi(y) < offset) {
       const Vec3d n = c.normal(last);
       xr = last.cast<Real>();
       v = c.resolve(last, n, v);
@@ -50,7 +51,8 @@ int project_point(const Collider& c, double dx, double dt, bool sweep, Vec3& xr,
 
 ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders, double dx,
                                          double dt, std::vector<Vec3>& x, std::vector<Vec3>& v,
-                                         const std::vector<std::uint8_t>* held, bool serial) {
+                                         const std::vector<std::uint8_t>* held, bool serial,
+                                         double offset) {
   ProjectionStats total;
   if (colliders.empty() || x.empty()) return total;
   const std::vector<ProjectionStats> part =
@@ -62,7 +64,7 @@ ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders,
                       bool moved = false;
                       for (int pass = 0; pass < 2 && (pass == 0 || moved); ++pass)
                         for (const Collider& c : colliders) {
-                          const int r = project_point(c, dx, dt, pass == 0, x[i], v[i]);
+                          const int r = project_point(c, dx, dt, offset, pass == 0, x[i], v[i]);
                           st.inside += r == 1;
                           st.swept += r == 2;
                           moved = moved || r != 0;

@@ -30,9 +30,12 @@ struct ProjectionStats {
 
 /// Projects points x (velocities v, advected over dt with x += dt v) out of the colliders
 /// (their begin_step set for this step). held: per point, components a pin prescribes
-/// (bit a; may be null): such points are left alone.
+/// (bit a; may be null): such points are left alone. offset [m]: the points' contact
+/// surface lies that far out from them (half a shell's contact thickness), so they are put
+/// back at phi = offset.
 ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders, double dx,
                                          double dt, std::vector<Vec3>& x, std::vector<Vec3>& v,
-                                         const std::vector<std::uint8_t>* held, bool serial);
+                                         const std::vector<std::uint8_t>* held, bool serial,
+                                         double offset = 0);
 
 }  // namespace shellmpm

@@ -23,22 +23,28 @@ inline Real inverse_field_mass(Real m, Real held) {
 
 /// Fields a and b at one node: n the unit normal from a towards b, wa and wb their
 /// inverse masses (0: pinned, infinitely heavy), va and vb their velocities. When they
-/// approach along n they end with the same normal velocity, and their relative
-/// tangential velocity drops by `friction` times the relative normal one (sticking at
-/// zero); the momentum changes are equal and opposite. Separating fields keep theirs.
-inline void field_contact(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb) {
+/// approach along n faster than `allow` [m/s] (0: not at all; contact_gap.h: the gap
+/// between their contact surfaces over the step), their relative normal velocity becomes
+/// -allow, and their relative tangential velocity drops by `friction` times the normal
+/// velocity removed (sticking at zero); the momentum changes are equal and opposite.
+/// Separating fields, and fields closing slower than `allow`, keep theirs. Returns whether
+/// the rule acted (the bodies touch within the step).
+inline bool field_contact(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb,
+                          Real allow = 0) {
   const Real w = wa + wb;
-  if (!(w > 0)) return;
+  if (!(w > 0)) return false;
   const Vec3 u = vb - va;
   const Real un = u.dot(n);
-  if (un >= 0) return;  // separating
+  if (un + allow >= 0) return false;  // separating, or not closing the gap in this step
   Vec3 ut = u - un * n;
   const Real tl = ut.norm();
-  const Real drop = -friction * un;
+  const Real drop = -friction * (un + allow);
   ut = tl <= drop ? Vec3::Zero() : Vec3(ut * (1 - drop / tl));
-  const Vec3 du = ut - u;
+  // allow = 0 (touching) in the same operations as before the gap existed.
+  const Vec3 du = allow > 0 ? Vec3(ut - allow * n - u) : Vec3(ut - u);
   va -= (wa / w) * du;
   vb += (wb / w) * du;
+  return true;
 }
 
 }  // namespace shellmpm

@@ -247,7 +247,7 @@ double ShellContact::energy(const Vec3* ctrl, bool serial) const {
 }
 
 ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const FrameLanes& fl,
-                                                          int j) {
+                                                          int j, bool apart) {
   // The frame in double: in float |q3| = 1 - O(1e-7) with a bias, and rebuilding a3E from
   // it every step would shrink a sticking column steadily (a spurious compression).
   Vec3d q[3];
@@ -258,6 +258,7 @@ ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const F
   // treated as separated (stored energy below k_c 1e-18 / 3).
   if (s[2] > Real(1) - kSeparationTolerance) s[2] = std::max(s[2], Real(1));
   const Real psi0 = contact_energy_density<Real>(s, params_);
+  if (apart) s = Vec3(0, 0, 1);  // separated from every other body: no contact state
   const Real slip0 = std::hypot(s[0], s[1]);
   const ContactState st = contact_return_map<Real>(s, params_);
   a3e[p] = (static_cast<double>(s[0]) * q[0] + static_cast<double>(s[1]) * q[1] +
@@ -284,7 +285,8 @@ ShellContact::ReturnMapSums ShellContact::return_map_site(std::size_t p, const F
   return r;
 }
 
-ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
+ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial,
+                                          const std::uint8_t* release) {
   using Acc = ReturnMapSums;
   static_assert(sizeof(StencilWeight) == 3 * sizeof(Real));
   const contact_lanes::SiteStencils stencils{
@@ -320,7 +322,10 @@ ContactStepStats ShellContact::return_map(const Vec3* ctrl, bool serial) {
             }
           }
           contact_lanes::frames(fl);
-          for (int j = 0; j < n; ++j) acc += return_map_site(p0 + std::size_t(j), fl, j);
+          for (int j = 0; j < n; ++j) {
+            const std::size_t p = p0 + std::size_t(j);
+            acc += return_map_site(p, fl, j, release && release[p]);
+          }
         }
         return acc;
       });

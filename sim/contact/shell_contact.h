@@ -47,8 +47,9 @@ class ShellContact {
   /// Energy only [J].
   double energy(const Vec3* ctrl, bool serial) const;
   /// Coulomb return mapping with the current control points and a3E; rewrites a3E and
-  /// updates the site positions x.
-  ContactStepStats return_map(const Vec3* ctrl, bool serial);
+  /// updates the site positions x. release (may be null): per site, 1 where the site is
+  /// apart from every other body (ShellFields::apart_sites): it is reset as separated.
+  ContactStepStats return_map(const Vec3* ctrl, bool serial, const std::uint8_t* release = nullptr);
   /// Makes the current shape the contact rest state: a3E = the unit normal, C = 0, and
   /// the positions updated (after a pre-roll moved the control points).
   void reset(const Vec3* ctrl, bool serial);
@@ -92,7 +93,7 @@ class ShellContact {
   using FrameLanes = contact_lanes::FrameLanes;
   using GradientLanes = contact_lanes::GradientLanes;
   /// The return mapping of site p with its frame in lane j of fl.
-  ReturnMapSums return_map_site(std::size_t p, const FrameLanes& fl, int j);
+  ReturnMapSums return_map_site(std::size_t p, const FrameLanes& fl, int j, bool apart);
 
   /// Site p's position (update_positions).
   Vec3 position(const Vec3* ctrl, std::size_t p) const;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "sim/contact/contact_gap.h"
 #include "sim/contact/field_contact.h"
 #include "sim/core/check.h"
 #include "sim/core/parallel.h"
@@ -340,33 +341,54 @@ Vec3 ShellFields::contact_normal(const Body& A, const Body& B, Real sign) {
   return (A.nrm + sign * B.nrm).normalized();
 }
 
-void ShellFields::shell_pairs(std::vector<Body>& bodies) const {
+Real ShellFields::shell_gap(const Body& A, const Body& B, Real h) const {
+  if (!surfaces_) return -std::numeric_limits<Real>::infinity();
+  return h * dx_ - (half_thickness_[A.shell] + half_thickness_[B.shell]);
+}
+
+bool ShellFields::shell_pairs(std::vector<Body>& bodies) const {
+  bool acted = false;
   const std::size_t cnt = bodies.size();
   for (std::size_t i = 0; i < cnt; ++i)
     for (std::size_t j = i + 1; j < cnt; ++j) {
       Body &A = bodies[i], &B = bodies[j];
       const Real facing = A.nrm.dot(B.nrm);
       Vec3 nab;  // unit normal from a towards b
+      Real h;    // centroid distance along nab [cells]
       if (facing < Real(-0.5)) {
         nab = contact_normal(A, B, Real(-1));
+        h = nab.dot(B.off - A.off);
       } else if (facing > Real(0.5)) {
         // Both on the same side of the node: closer than a cell, no node between
         // them. The one whose centroid lies nearer the node along their common
         // normal u is in front; without this the rule let go exactly when two
         // sheets were pressed closest (hanging curtains hit at 20 m/s crossed).
         const Vec3 u = contact_normal(A, B, Real(1));
-        const Real h = u.dot(B.off - A.off);
-        if (std::abs(h) < Real(0.05)) continue;
+        h = u.dot(B.off - A.off);
+        if (std::abs(h) < Real(0.05)) {
+          if (!surfaces_) continue;
+          // Level within round-off: touching at any contact thickness; no normal to
+          // choose, so the rule waits for the next step.
+          A.touched = B.touched = acted = true;
+          continue;
+        }
         nab = h > 0 ? u : Vec3(-u);
+        h = std::abs(h);
       } else {
         continue;
       }
-      field_contact(nab, std::sqrt(friction_[A.shell] * friction_[B.shell]), A.winv, A.vel, B.winv,
-                    B.vel);
+      const Real gap = shell_gap(A, B, h);
+      const bool met = field_contact(nab, std::sqrt(friction_[A.shell] * friction_[B.shell]),
+                                     A.winv, A.vel, B.winv, B.vel, closing_allowance(gap, dt_)) ||
+                       gap <= 0;
+      A.touched = A.touched || met;
+      B.touched = B.touched || met;
+      acted |= met;
     }
+  return acted;
 }
 
-void ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk) const {
+bool ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk) const {
   // Which side of a shell the bulk material is on: where its mass centroid lies
   // along the shell's own normal (Nairn's multi-material contact takes the
   // normal from the mass distribution the same way). The node's side is not
@@ -381,15 +403,29 @@ void ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real m
     ok = Vec3(bm->o[0], bm->o[1], bm->o[2]);
     have_ok = true;
   }
+  // The bulk surface's distance from the node [cells, positive outside the material], from
+  // its volume fraction there (contact_gap.h); without the sums, at the node.
+  const Real s =
+      have_ok && surfaces_ ? surface_distance_from_share(bm->m / (dx_ * dx_ * dx_)) : Real(0);
+  bool acted = false;
   for (Body& B : bodies) {
     Vec3 nb = B.nrm;
     if (have_ok && B.own.squaredNorm() > 0) {
       const Real d = B.own.dot(ok - B.off);
       if (std::abs(d) > Real(0.05)) nb = d > 0 ? B.own : Vec3(-B.own);
     }
-    if (nb.squaredNorm() > 0)
-      field_contact(nb, friction_[B.shell], B.winv, B.vel, Real(1) / mk, vk);
+    if (nb.squaredNorm() == 0) continue;
+    // nb points from the shell to the bulk: the shell's centroid lies -nb . off cells
+    // beyond the node, the material's surface s cells before it.
+    const Real gap = surfaces_ && have_ok ? (s - nb.dot(B.off)) * dx_ - half_thickness_[B.shell]
+                                          : -std::numeric_limits<Real>::infinity();
+    const bool met = field_contact(nb, friction_[B.shell], B.winv, B.vel, Real(1) / mk, vk,
+                                   closing_allowance(gap, dt_)) ||
+                     gap <= 0;
+    B.touched = B.touched || met;
+    acted |= met;
   }
+  return acted;
 }
 
 void ShellFields::resolve_node(const GridNode& cn, std::size_t g, int n, bool moments,
@@ -408,11 +444,18 @@ void ShellFields::resolve_node(const GridNode& cn, std::size_t g, int n, bool mo
   for (Body& B : bodies) body_geometry(B);
   // Shell against shell (facing across the node, or stacked on one side of it),
   // then each shell against the bulk field: Bardenhagen's rule.
-  shell_pairs(bodies);
-  if (bulk) bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk);
+  bool acted = shell_pairs(bodies);
+  if (bulk) acted |= bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk);
   for (const Body& B : bodies) *B.r = B.vel - v0;
   if (bulk) r_bulk_[g][n] = vk - v0;
   shared_[g] |= std::uint64_t(1) << n;
+  if (acted) {
+    const int* fb = fblock_.data() + g * fields_.size();
+    for (const Body& B : bodies)
+      if (B.touched)
+        fields_[std::size_t(B.shell)].touch[std::size_t(fb[B.shell])] |= std::uint64_t(1) << n;
+  }
+  if (bulk) bulk_at_[g] |= std::uint64_t(1) << n;
 }
 
 void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& shells, Real dt,
@@ -427,6 +470,10 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   find_field_blocks(combined, serial);
   r_bulk_.resize(ng);
   shared_.assign(ng, 0);
+  for (Field& F : fields_) F.touch.assign(F.nodes.size(), 0);
+  bulk_at_.assign(ng, 0);
+  dt_ = dt;
+  dx_ = static_cast<Real>(combined.dx());
   const bool moments = bulk_particles && bulk_particles->size() > 0;
   if (moments) bulk_moments(combined, *bulk_particles, first_bulk, serial);
   parallel_for(
@@ -445,7 +492,102 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
       serial);
 }
 
-void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial) {
+void ShellFields::apart_sites(const SparseGrid& combined, const ShellPointTable& table,
+                              const std::vector<Vec3>& points,
+                              std::vector<std::vector<std::uint8_t>>& release, bool serial) const {
+  const std::uint32_t first_site = table.num_control_points(), end = std::uint32_t(table.size());
+  parallel_for_each(
+      combined.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        const auto& nbr = combined.pblock_nbr[b];
+        // Nothing shared around this block: its sites keep their state.
+        if (std::none_of(nbr.begin(), nbr.end(),
+                         [&](int g) { return g >= 0 && shared_[std::size_t(g)] != 0; }))
+          return;
+        const Vec3i bc = unpack_block(combined.pblock_key[b]) * kBlockSize;
+        combined.for_each_point(b, [&](std::uint32_t i) {
+          if (i < first_site || i >= end) return;  // control points; bulk particles
+          const QuadraticWeights W(combined.grid_coord(points[i]));
+          const std::size_t s = table.shell(i), K = fields_.size();
+          const Field& F = fields_[s];
+          // Apart: some node of the stencil is shared with a body the shell does not touch.
+          bool apart = false;
+          for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+            const int g = nbr[(n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2)];
+            if (apart || g < 0) return;
+            const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
+            if (!(shared_[std::size_t(g)] >> bn & 1)) return;
+            const int fb = fblock_[std::size_t(g) * K + s];
+            apart = !(fb >= 0 && (F.touch[std::size_t(fb)] >> bn & 1));
+          });
+          if (apart) release[s][table.local(i)] = 1;
+        });
+      },
+      serial);
+}
+
+void ShellFields::keep_free_velocities(const SparseGrid& combined, bool serial) {
+  const std::size_t ng = combined.num_grid_blocks();
+  free_slot_.assign(ng, -1);
+  int slots = 0;
+  for (std::size_t g = 0; g < ng; ++g)
+    if (g < shared_.size() && shared_[g]) free_slot_[g] = slots++;
+  free_.resize(std::size_t(slots));
+  parallel_for_each(
+      ng, 16,
+      [&](std::size_t g) {
+        if (free_slot_[g] < 0) return;
+        auto& f = free_[std::size_t(free_slot_[g])];
+        for (int n = 0; n < kBlockNodes; ++n) {
+          const GridNode& nd = combined.gblock_nodes[g][n];
+          f[n] = Vec3(nd.v[0], nd.v[1], nd.v[2]);
+        }
+      },
+      serial);
+}
+
+void ShellFields::gate_collider_node(GridNode& nd, std::size_t g, int n, const Vec3& node_pos,
+                                     const ColliderGate& gate) {
+  const std::size_t K = fields_.size();
+  const int* fb = fblock_.data() + g * K;
+  const Vec3 vf = free_[std::size_t(free_slot_[g])][n];
+  const Real dt = dt_;
+  // A body's velocity, its own (vf + r), meets the collider's condition where its contact
+  // surface (at `gap` [m] from the collider) comes within reach in the step.
+  const auto body = [&](Real gap, const Vec3& r) -> Vec3 {
+    Vec3 own = vf + r;
+    if (gap <= gate.reach + dt * own.norm()) gate.apply(g, n, own);
+    return own;
+  };
+  const auto shell_gap = [&](const Node& f, int s) {
+    const Vec3 c = node_pos + dx_ * Vec3(f.o[0], f.o[1], f.o[2]);
+    return Real(gate.phi(c.cast<double>())) - half_thickness_[std::size_t(s)];
+  };
+  // The bulk field: its surface along the collider's normal lies s cells beyond the node
+  // (its volume fraction there, contact_gap.h).
+  Vec3 node_v(nd.v[0], nd.v[1], nd.v[2]);  // with the collider's condition
+  if (bulk_at_[g] >> n & 1) {
+    const Moment& bm = bulk_mom_[g][n];
+    const Real sk = bm.m > 0 ? surface_distance_from_share(bm.m / (dx_ * dx_ * dx_)) : Real(0);
+    node_v = body(Real(gate.phi(node_pos.cast<double>())) + sk * dx_, r_bulk_[g][n]);
+  }
+  for (std::size_t s = 0; s < K; ++s) {
+    if (fb[s] < 0) continue;
+    Field& F = fields_[s];
+    Node& f = F.nodes[fb[s]][n];
+    Vec3& r = F.r[fb[s]][n];
+    if (f.m > 0) r = body(shell_gap(f, int(s)), r) - node_v;
+    const int fi = F.fold[fb[s]];
+    if (fi < 0) continue;
+    Node& f2 = F.folds[fi].second[n];
+    Vec3& r2 = F.folds[fi].r[n];
+    if (f2.m > 0) r2 = body(shell_gap(f2, int(s)), r2) - node_v;
+  }
+  for (int a = 0; a < 3; ++a) nd.v[a] = node_v[a];
+}
+
+void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial,
+                             const ColliderGate* gate) {
   const std::size_t K = fields_.size();
   parallel_for_each(
       combined.num_grid_blocks(), 4,
@@ -455,7 +597,13 @@ void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool seri
         const Vec3i c = unpack_block(combined.gblock_key[g]) * kBlockSize;
         for (int n = 0; n < kBlockNodes; ++n) {
           if (!(shared_[g] >> n & 1)) continue;
-          const bool one = skip && skip(c + Vec3i(n >> 4, (n >> 2) & 3, n & 3));
+          const Vec3i node = c + Vec3i(n >> 4, (n >> 2) & 3, n & 3);
+          const bool one = skip && skip(node);
+          if (!one && gate && gate->engaged(g, n)) {
+            gate_collider_node(combined.gblock_nodes[g][n], g, n,
+                               combined.node_position(node).cast<Real>(), *gate);
+            continue;
+          }
           const Vec3 rk = r_bulk_[g][n];
           for (std::size_t s = 0; s < K; ++s) {
             if (fb[s] < 0) continue;

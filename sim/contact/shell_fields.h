@@ -58,6 +58,28 @@ class ShellFields {
   /// there are two bodies or more (two shells, a shell and bulk, or a folding shell).
   void setup(const SparseGrid& grid, std::size_t num_shells, bool bulk, bool folds);
   bool active() const { return active_; }
+  /// Contact at the bodies' surfaces (contact_gap.h): the rule between two bodies at a
+  /// node lets them close by the gap between their contact surfaces, half_thickness[s]
+  /// [m] on each side of shell s's surface, and bulk material's surface where its volume
+  /// fraction puts it. Off: they stop closing wherever they share a node (the paper).
+  void set_contact_surfaces(bool on, std::vector<Real> half_thickness) {
+    surfaces_ = on;
+    half_thickness_ = std::move(half_thickness);
+  }
+  /// With contact at the surfaces: marks the contact particles whose stencil holds a node
+  /// that their shell shares with a body it does not touch there (release[s][p] = 1 for
+  /// site p of grid shell s; others 0). A site reads the node's common velocity, so such a
+  /// site's normal column was squeezed by the other body's motion across a real gap, and
+  /// its normal force, applied to the node, would push that body a cell early (a sheet
+  /// falling on a pile stopped 0.75 dx above it). The return mapping treats it as
+  /// separated: contact between bodies is then the gated pair rule's (and the shell
+  /// guard's at the thickness), and the paper's contact elasticity acts where nothing
+  /// else shares the stencil (self-contact, colliders). points: the combined binning's
+  /// shell points (control points, then contact particles).
+  void apart_sites(const SparseGrid& combined, const ShellPointTable& table,
+                   const std::vector<Vec3>& points, std::vector<std::vector<std::uint8_t>>& release,
+                   bool serial) const;
+  bool contact_at_surfaces() const { return active_ && surfaces_; }
 
   /// Before the combined P2G: where one shell alone has fields (its folds' heights only),
   /// its control-point normals and the heights for shell_p2g_block to sum; else null.
@@ -69,10 +91,31 @@ class ShellFields {
   /// bulk: the bulk particles, binned in `combined` as first_bulk + index (null: none).
   void p2g(const SparseGrid& combined, const std::vector<GridShell>& shells, Real dt,
            const ParticleSet* bulk, std::uint32_t first_bulk, bool serial);
+  /// With contact at the surfaces, which bodies at a shared node a collider's condition
+  /// applies to: a node inside a collider stands for everything within 1.5 dx, and a thin
+  /// sheet on the ground engages it, so a block resting on that sheet read the ground's
+  /// velocity there and floated a cell above the sheet. Only bodies whose contact surface
+  /// at the node lies within `reach` of a collider (plus their step's travel) take it;
+  /// the others keep the velocity the grid update gave them.
+  struct ColliderGate {
+    /// Whether node n of combined grid block g takes a collider's condition.
+    std::function<bool(std::size_t g, int n)> engaged;
+    /// Signed distance [m] from world x to the nearest collider (positive outside).
+    std::function<double(const Vec3d& x)> phi;
+    /// Applies the conditions of the colliders that node n of block g takes to a body's
+    /// velocity v there.
+    std::function<void(std::size_t g, int n, Vec3& v)> apply;
+    Real reach = 0;  ///< [m]
+  };
+  /// Before the colliders' conditions (with a gate): keeps the shared nodes' velocities.
+  void keep_free_velocities(const SparseGrid& combined, bool serial);
   /// After the grid update, before G2P: drops the relative velocities where skip() says
   /// so, and gives shared nodes the bulk field's velocity (bulk particles, contact
-  /// particles and the shells' plain G2P then read it).
-  void before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial);
+  /// particles and the shells' plain G2P then read it). With a gate (and
+  /// keep_free_velocities called), skip() names the walls only, and collider nodes give
+  /// each body the collider's velocity or its own (ColliderGate).
+  void before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial,
+                  const ColliderGate* gate = nullptr);
   /// After G2P: each control point gets v += sum w r, x += dt sum w r and C += the
   /// matching APIC term, r its shell's velocity relative to the node's (held components
   /// unchanged).
@@ -110,7 +153,8 @@ class ShellFields {
       hmax = std::max(hmax, b.hmax);
     }
   };
-  /// Bulk mass and first moment sum w m (x_p - x_node) / dx at a node.
+  /// Bulk volume sum w V and first moment sum w V (x_p - x_node) / dx at a node (the
+  /// centroid offset after bulk_moments).
   struct Moment {
     Real m;
     Real o[3];
@@ -148,8 +192,11 @@ class ShellFields {
     /// heights_only_, where the shell folds: the combined P2G's heights on this grid.
     std::vector<std::array<NodeHeights, kBlockNodes>> heights;
     std::vector<std::array<Vec3, kBlockNodes>> r;  ///< velocity relative to the node
-    std::vector<Vec3> x0;                          ///< control points at p2g time
-    std::vector<Vec3> normal;                      ///< control-point unit normals
+    /// Per grid block, a bit per node: the shell (either class) touched another body there
+    /// in the last p2g (the rule acted on a pair with it, or their surfaces overlap).
+    std::vector<std::uint64_t> touch;
+    std::vector<Vec3> x0;      ///< control points at p2g time
+    std::vector<Vec3> normal;  ///< control-point unit normals
     /// The shell's triangles at each control point, ascending: tri_of[tri_start[i] ..
     /// tri_start[i + 1]) (built once).
     std::vector<std::uint32_t> tri_start, tri_of;
@@ -233,6 +280,7 @@ class ShellFields {
     Vec3* r;                  ///< where its relative velocity goes
     Vec3 vel, nrm, own, off;  ///< velocity, normal to the node, own normal, centroid
     Real winv;                ///< inverse effective mass (pinned share: infinite)
+    bool touched = false;     ///< the rule acted on a pair with it (or their surfaces overlap)
   };
   // Steps of p2g().
   /// fblock_, fielded_: each field's block at each combined grid block.
@@ -250,10 +298,15 @@ class ShellFields {
   /// pinned one tilted the normal with it, and the normal impulse pushed it on down the
   /// slope: 16% faster than Coulomb at dx 0.028 (issue 13's incline_sheet).
   static Vec3 contact_normal(const Body& A, const Body& B, Real sign);
-  /// Shell against shell at one node (facing across it, or stacked on one side).
-  void shell_pairs(std::vector<Body>& bodies) const;
-  /// Each shell against the bulk field (mass mk, velocity vk; bm its centroid, or null).
-  void bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk) const;
+  /// Shell against shell at one node (facing across it, or stacked on one side); returns
+  /// whether the rule acted on a pair.
+  bool shell_pairs(std::vector<Body>& bodies) const;
+  /// Each shell against the bulk field (mass mk, velocity vk; bm its centroid and volume
+  /// sum, or null); returns whether the rule acted on a pair.
+  bool bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk) const;
+  /// The gap [m] between shells a and b at a node whose centroids lie h cells apart along
+  /// the normal from a to b; -inf where contact is at the stencils.
+  Real shell_gap(const Body& A, const Body& B, Real h) const;
   /// Bardenhagen's rule at node n of combined grid block g (combined node cn): the
   /// bodies' and the bulk field's velocities relative to the node's, and its shared_ bit.
   void resolve_node(const GridNode& cn, std::size_t g, int n, bool moments,
@@ -262,7 +315,10 @@ class ShellFields {
   void bulk_moments(const SparseGrid& combined, const ParticleSet& bulk, std::uint32_t first_bulk,
                     bool serial);
   bool active_ = false;
-  bool folds_ = false;  ///< split_folds on
+  bool folds_ = false;                ///< split_folds on
+  bool surfaces_ = false;             ///< contact at the surfaces (set_contact_surfaces)
+  std::vector<Real> half_thickness_;  ///< per shell [m]
+  Real dt_ = 0, dx_ = 0;              ///< of the last p2g [s], [m]
   /// One shell and no bulk material: a node holds two bodies only where the shell folds
   /// (its two classes), so only mass and heights are summed, in the combined P2G
   /// (heights_), and full sums (Field::nodes) exist on fold blocks only, from the classes.
@@ -280,6 +336,15 @@ class ShellFields {
   std::vector<std::array<Moment, kPadNodes>> bulk_buf_;    ///< per combined particle block
   std::vector<std::array<Moment, kBlockNodes>> bulk_mom_;  ///< per combined grid block
   std::vector<std::uint64_t> shared_;
+  std::vector<std::uint64_t> bulk_at_;  ///< per combined grid block: the bulk field is there
+  /// Shared nodes' velocities before the colliders' conditions (keep_free_velocities), per
+  /// combined grid block with shared nodes: free_[free_slot_[g]].
+  std::vector<int> free_slot_;
+  std::vector<std::array<Vec3, kBlockNodes>> free_;
+  /// Node n of combined grid block g under a collider gate: each body keeps its own
+  /// velocity, with the collider's condition applied to it where it is near the collider.
+  void gate_collider_node(GridNode& nd, std::size_t g, int n, const Vec3& node_pos,
+                          const ColliderGate& gate);
 };
 
 }  // namespace shellmpm

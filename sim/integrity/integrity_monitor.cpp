@@ -267,7 +267,9 @@ IntegrityReport IntegrityMonitor::snapshot(const IntegrityView& view) {
 
 void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityReport& r) const {
   r.active = true;
+  r.dx = dx_;
   r.collider_limit = kColliderCells * dx_;
+  measure_gaps(view, r);
   check_non_finite(view, r);
   check_crossings(view, r);
   std::vector<IntegrityEvent> warnings;
@@ -275,6 +277,90 @@ void IntegrityMonitor::frame_end_checks(const IntegrityView& view, IntegrityRepo
   if (view.colliders)
     for (const Collider& c : *view.colliders) check_collider(view, c, r);
   r.events.insert(r.events.end(), warnings.begin(), warnings.end());
+}
+
+std::pair<double, int> IntegrityMonitor::nearest_shell(const Vec3d& x, int exclude) const {
+  thread_local std::vector<int> cand;
+  double best = band_ * band_;
+  int shell = -1;
+  for (std::size_t s = 0; s < shells_.size(); ++s) {
+    if (static_cast<int>(s) == exclude) continue;
+    const ShellGeom& g = shells_[s];
+    g.grid.query(x, cand);
+    const auto& T = g.limit->triangles();
+    for (int t : cand) {
+      const Vec3d& a = g.pos[T[t][0]];
+      const Vec3d& b = g.pos[T[t][1]];
+      const Vec3d& c = g.pos[T[t][2]];
+      const Vec3d bc = closest_point_barycentric(x, a, b, c);
+      const double d2 = (x - (bc[0] * a + bc[1] * b + bc[2] * c)).squaredNorm();
+      if (d2 < best) {
+        best = d2;
+        shell = static_cast<int>(s);
+      }
+    }
+  }
+  return {std::sqrt(best), shell};
+}
+
+namespace {
+/// Least and median of a list of gaps (the median of an even count is the lower middle).
+GapSummary summarise(std::vector<double>& g) {
+  GapSummary out;
+  out.count = g.size();
+  if (g.empty()) return out;
+  out.min = *std::min_element(g.begin(), g.end());
+  auto mid = g.begin() + static_cast<std::ptrdiff_t>((g.size() - 1) / 2);
+  std::nth_element(g.begin(), mid, g.end());
+  out.median = *mid;
+  return out;
+}
+}  // namespace
+
+/// Gaps between contact surfaces: every shell limit vertex against the nearest other
+/// shell and every collider, every bulk particle against the nearest shell.
+void IntegrityMonitor::measure_gaps(const IntegrityView& view, IntegrityReport& r) const {
+  const std::size_t nb = view.bulk ? view.bulk->size() : 0;
+  const std::size_t nv = vertex_offset_.back();
+  const auto half = [&view](std::size_t s) {
+    return s < view.half_thickness.size() ? view.half_thickness[s] : 0.0;
+  };
+  struct Lists {
+    std::vector<double> ss, sb, sc;
+  };
+  const std::size_t n = shells_.empty() ? 0 : nv + nb;
+  const std::vector<Lists> parts =
+      chunk_parts(n, kGrain, view.serial, Lists(), [&](std::size_t b, std::size_t e, Lists& l) {
+        std::size_t s = 0;
+        for (std::size_t i = b; i < e; ++i) {
+          const Vec3d x = point(view, i, s);
+          if (!x.allFinite()) continue;
+          const bool vertex = i < nv;
+          // A bulk particle's volume as a sphere of half its spacing.
+          const double own =
+              vertex ? half(s) : 0.5 * std::cbrt(double(view.bulk->volume_of(i - nv)));
+          const auto [d, other] = nearest_shell(x, vertex ? static_cast<int>(s) : -1);
+          if (other >= 0) (vertex ? l.ss : l.sb).push_back(d - own - half(std::size_t(other)));
+          if (!vertex || !view.colliders) continue;
+          for (const Collider& c : *view.colliders) {
+            Aabb at;
+            at.lo = x.array() - band_;
+            at.hi = x.array() + band_;
+            if (!c.bounds().overlaps(at)) continue;
+            const double phi = c.phi(x);
+            if (phi < band_) l.sc.push_back(phi - own);
+          }
+        }
+      });
+  Lists all;
+  for (const Lists& l : parts) {
+    all.ss.insert(all.ss.end(), l.ss.begin(), l.ss.end());
+    all.sb.insert(all.sb.end(), l.sb.begin(), l.sb.end());
+    all.sc.insert(all.sc.end(), l.sc.begin(), l.sc.end());
+  }
+  r.shell_shell = summarise(all.ss);
+  r.shell_bulk = summarise(all.sb);
+  r.shell_collider = summarise(all.sc);
 }
 
 /// Non-finite positions or velocities of bulk particles and control points.

@@ -20,6 +20,8 @@
 //   a vertex with the edge excepted). This finds folds and twists that cross.
 // - Colliders: bulk particles and shell limit vertices deeper than 0.5 dx inside one.
 // - Non-finite positions or velocities.
+// - The gaps between contact surfaces (GapSummary): a report, not a failure, so a user can
+//   check that bodies rest at their real distance.
 // Side records live only within a frame (a frame starts by recording every point), so
 // a resumed run reports exactly what an uninterrupted one does.
 #pragma once
@@ -40,6 +42,7 @@ namespace shellmpm {
 struct IntegrityView {
   const ParticleSet* bulk = nullptr;
   std::vector<const ShellObject*> shells;  ///< shells with contact (on the grid)
+  std::vector<double> half_thickness;      ///< per shell: half its contact thickness [m]
   const std::vector<Collider>* colliders = nullptr;
   bool serial = false;
 };
@@ -86,6 +89,10 @@ class IntegrityMonitor {
   void check_crossings(const IntegrityView& view, IntegrityReport& r) const;
   void check_stretched(IntegrityReport& r, std::vector<IntegrityEvent>& warnings) const;
   void check_collider(const IntegrityView& view, const Collider& c, IntegrityReport& r) const;
+  void measure_gaps(const IntegrityView& view, IntegrityReport& r) const;
+  /// The nearest point of a shell other than `exclude` within the band: its distance [m]
+  /// and shell, or shell -1.
+  std::pair<double, int> nearest_shell(const Vec3d& x, int exclude) const;
   const std::vector<Eigen::Vector3i>& tris(std::size_t s) const {
     return shells_[s].limit->triangles();
   }

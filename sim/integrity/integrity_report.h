@@ -28,6 +28,17 @@ struct IntegrityEvent {
   Vec3d where{0, 0, 0};  ///< a place where it happened (first crossing, deepest point)
 };
 
+/// Gaps between contact surfaces at the frame's end, over the points within the monitor's
+/// band (2 dx) of another body: each shell limit vertex or bulk particle counts its
+/// nearest other surface once. A gap is the distance between the surfaces (a shell's
+/// limit surface offset by half its contact thickness; bulk particles' volume, a sphere
+/// of half the particle spacing; a collider's level set); negative where they overlap.
+struct GapSummary {
+  std::size_t count = 0;  ///< points within the band
+  double min = 0;         ///< smallest gap [m]
+  double median = 0;      ///< median gap [m]
+};
+
 /// One frame's integrity counts (all zero when nothing went wrong).
 struct IntegrityReport {
   bool active = false;                    ///< false: the scene has nothing the monitor checks
@@ -42,6 +53,10 @@ struct IntegrityReport {
   std::size_t non_finite = 0;             ///< non-finite positions or velocities
   std::size_t stretched_edges = 0;        ///< contact-shell edges longer than 2 dx (a warning)
   double max_edge = 0;                    ///< longest contact-shell limit-mesh edge [m]
+  double dx = 0;                          ///< grid spacing [m] (gaps are also written in cells)
+  GapSummary shell_shell;                 ///< shell vertices against other shells
+  GapSummary shell_bulk;                  ///< bulk particles against shells
+  GapSummary shell_collider;              ///< shell vertices against colliders
   std::vector<IntegrityEvent> events;     ///< failures, then warnings
 
   bool failed() const {

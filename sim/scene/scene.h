@@ -23,6 +23,11 @@ enum class Quality { Draft, Preview, Production, Final };
 /// Whether shells that share grid nodes share one velocity there (no-slip between them, as
 /// in the paper) or each keeps its own (ShellFields; friction from contact only).
 enum class ShellVelocities { PerShell, Shared };
+/// Where grid contact between two bodies acts: where their contact surfaces meet (a
+/// shell's limit surface offset by half its contact thickness, bulk material where its
+/// particles' volume ends; sim/contact/contact_gap.h), or wherever their B-spline
+/// stencils share a node (the paper's behaviour: bodies rest one to two cells apart).
+enum class ContactAt { Surface, Stencil };
 
 /// Shot-wide settings.
 /// How a step advances: explicit (symplectic Euler, steps bounded by the fastest elastic
@@ -52,6 +57,8 @@ struct ShotSettings {
   /// (sim/contact/shell_folds.cpp), so a fold slides over its own cloth at Coulomb's law;
   /// false: one (the fold drags; cheaper for a lone shell).
   bool fold_fields = true;
+  /// Where grid contact acts (ContactAt): at the bodies' surfaces, or the paper's cushion.
+  ContactAt contact_at = ContactAt::Surface;
   /// The shell guard (sim/contact/shell_guard.h): stops contact shells from closing
   /// closer than shell_guard_gap where the grid cannot hold them apart.
   bool shell_guard = true;
@@ -167,9 +174,12 @@ struct ShellMaterialDesc {
   double friction = 0.3;                    ///< Coulomb coefficient c_F between shells
   std::optional<double> contact_stiffness;  ///< k_c [Pa]; none: youngs_modulus
   std::optional<double> contact_shear;      ///< gamma [Pa]; none: the contact stiffness
-  int contact_samples = 1;                  ///< contact particles per triangle: 1, 3, 6 or 7
-  std::optional<Vec3d> front_color;         ///< preview colour of the +normal side; none: render's
-  std::optional<Vec3d> back_color;          ///< preview colour of the other side; none: render's
+  /// Thickness of the contact layer [m]: contact surfaces lie half of it on each side of
+  /// the limit surface. none: the shell's thickness.
+  std::optional<double> contact_thickness;
+  int contact_samples = 1;           ///< contact particles per triangle: 1, 3, 6 or 7
+  std::optional<Vec3d> front_color;  ///< preview colour of the +normal side; none: render's
+  std::optional<Vec3d> back_color;   ///< preview colour of the other side; none: render's
 };
 
 /// A rigid keyframed motion shared by pins (and colliders).

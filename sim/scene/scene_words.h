@@ -39,6 +39,7 @@ SHELLMPM_ENUM_WORDS(Quality, 4, {"draft", Quality::Draft}, {"preview", Quality::
                     {"production", Quality::Production}, {"final", Quality::Final});
 SHELLMPM_ENUM_WORDS(ShellVelocities, 2, {"per_shell", ShellVelocities::PerShell},
                     {"shared", ShellVelocities::Shared});
+SHELLMPM_ENUM_WORDS(ContactAt, 2, {"surface", ContactAt::Surface}, {"stencil", ContactAt::Stencil});
 SHELLMPM_ENUM_WORDS(ShotSettings::OnIntegrityFailure, 2,
                     {"warn", ShotSettings::OnIntegrityFailure::Warn},
                     {"stop", ShotSettings::OnIntegrityFailure::Stop});

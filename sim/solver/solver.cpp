@@ -96,6 +96,13 @@ void Solver::setup_contact() {
       c_.grid,
       c_.scene.shot.shell_velocities == ShellVelocities::Shared ? 0 : c_.grid_shells.size(),
       !c_.scene.sources.empty(), c_.scene.shot.fold_fields);
+  std::vector<Real> half;
+  for (const GridShell& g : c_.grid_shells) {
+    const ShellMaterialDesc& m = g.shell->material();
+    half.push_back(static_cast<Real>(0.5 * m.contact_thickness.value_or(m.thickness)));
+  }
+  c_.shell_fields.set_contact_surfaces(c_.scene.shot.contact_at == ContactAt::Surface,
+                                       std::move(half));
 }
 
 std::vector<std::string> Solver::stage_names() const {
@@ -107,7 +114,11 @@ std::vector<std::string> Solver::stage_names() const {
 IntegrityView Solver::integrity_view() const {
   IntegrityView v;
   v.bulk = &c_.particles;
-  for (const GridShell& g : c_.grid_shells) v.shells.push_back(g.shell);
+  for (const GridShell& g : c_.grid_shells) {
+    v.shells.push_back(g.shell);
+    const ShellMaterialDesc& m = g.shell->material();
+    v.half_thickness.push_back(0.5 * m.contact_thickness.value_or(m.thickness));
+  }
   v.colliders = &c_.colliders;
   v.serial = c_.opt.serial;
   return v;

@@ -57,17 +57,37 @@ void StepContext::apply_walls() {
       opt.serial);
 }
 
+double StepContext::contact_offset(const ShellObject& sh) const {
+  if (scene.shot.contact_at != ContactAt::Surface) return 0;
+  const ShellMaterialDesc& m = sh.material();
+  return 0.5 * m.contact_thickness.value_or(m.thickness);
+}
+
 void StepContext::compute_collider_reach() {
   const bool shells = !grid_shells.empty();
-  if (shells) shell_table.velocities(grid_shells, reach_velocities);
+  if (shells) {
+    shell_table.velocities(grid_shells, reach_velocities);
+    if (shell_point_offsets.size() != shell_table.size()) {
+      shell_point_offsets.resize(shell_table.size());
+      for (std::uint32_t i = 0; i < shell_table.size(); ++i)
+        shell_point_offsets[i] =
+            static_cast<Real>(contact_offset(*grid_shells[shell_table.shell(i)].shell));
+    }
+  }
   collider_reach.compute(grid, shells ? &shell_points : nullptr,
                          shells ? &reach_velocities : nullptr, particles.x, particles.v, colliders,
-                         kColliderReachCells * grid.dx(), dt, opt.serial);
+                         kColliderReachCells * grid.dx(), dt, opt.serial,
+                         shells ? &shell_point_offsets : nullptr);
+}
+
+bool StepContext::wall_node(const Vec3i& n) const {
+  for (int a = 0; a < 3; ++a)
+    if (n[a] < kWallCells || n[a] > domain_cells[a] - kWallCells) return true;
+  return false;
 }
 
 bool StepContext::single_velocity_node(const Vec3i& n) const {
-  for (int a = 0; a < 3; ++a)
-    if (n[a] < kWallCells || n[a] > domain_cells[a] - kWallCells) return true;
+  if (wall_node(n)) return true;
   Aabb at;
   at.lo = at.hi = grid.node_position(n);
   for (const Collider& c : colliders) {

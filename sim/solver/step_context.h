@@ -77,6 +77,8 @@ struct StepContext {
   /// and implicit_grid, for the colliders' pose at the end of the step.
   ColliderReach collider_reach;
   std::vector<Vec3> reach_velocities;  ///< scratch of compute_collider_reach
+  /// Per shell point of shell_table: contact_offset of its shell (compute_collider_reach).
+  std::vector<Real> shell_point_offsets;
   /// The grid shells' control points at the start of the step (x^n): written by g2p
   /// before it moves them, read by shell_guard, which runs after the colliders have
   /// projected points out (so x - dt v is not x^n for every point any more).
@@ -99,10 +101,15 @@ struct StepContext {
   void clamp_to_domain();
   /// Marks the nodes within reach of the colliders (posed for the step) in collider_reach.
   void compute_collider_reach();
+  /// How far out from a shell's surface its contact surface lies [m]: half its contact
+  /// thickness with shot.contact_at: surface, else 0 (colliders meet the surface itself).
+  double contact_offset(const ShellObject& sh) const;
   /// Stops the velocity components that point into the domain walls.
   void apply_walls();
   /// Nodes where shells keep one shared velocity: walls and colliders.
   bool single_velocity_node(const Vec3i& n) const;
+  /// Nodes within kWallCells of the domain's boundary.
+  bool wall_node(const Vec3i& n) const;
   /// Appends bulk particles of source i at positions pts (at rest velocity of the source).
   void add_particles_from(std::size_t source, const std::vector<Vec3d>& pts);
 };

@@ -21,13 +21,14 @@ void ColliderParticlesStage::run(StepContext& c) {
     if (c.contacts[i]) continue;
     c.shells[i]->pin_targets(c.time, c.dt, held, target);  // released pins hold nothing
     project_out_of_colliders(c.colliders, dx, c.dt, c.shells[i]->x, c.shells[i]->v, &held,
-                             c.opt.serial);
+                             c.opt.serial, c.contact_offset(*c.shells[i]));
   }
   if (!grid) return;
   project_out_of_colliders(c.colliders, dx, c.dt, c.particles.x, c.particles.v, nullptr,
                            c.opt.serial);
   for (GridShell& g : c.grid_shells)
-    project_out_of_colliders(c.colliders, dx, c.dt, g.shell->x, g.shell->v, &g.held, c.opt.serial);
+    project_out_of_colliders(c.colliders, dx, c.dt, g.shell->x, g.shell->v, &g.held, c.opt.serial,
+                             c.contact_offset(*g.shell));
   // A collider can push a point past the domain's last cell: back inside, as after g2p.
   c.clamp_to_domain();
 }

@@ -13,6 +13,10 @@ void CollidersStage::run(StepContext& c) {
   for (Collider& col : c.colliders) col.begin_step(c.time, c.dt);
   // The implicit grid stage has marked the reach for the step it took (c.dt) already.
   if (c.scene.shot.integrator != Integrator::Implicit) c.compute_collider_reach();
+  // Contact at the surfaces: the shared nodes' velocities before the conditions, for the
+  // bodies there that are not near a collider (ShellFields::ColliderGate, g2p).
+  if (c.shell_fields.contact_at_surfaces())
+    c.shell_fields.keep_free_velocities(c.grid, c.opt.serial);
   const double dx = c.grid.dx();
   parallel_for_each(
       c.grid.num_grid_blocks(), 16,

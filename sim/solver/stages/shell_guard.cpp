@@ -15,7 +15,8 @@ double ShellGuardStage::gap(const Scene& s) {
   double g = 0.05 * s.shot.dx;
   for (std::size_t i = 0; i < s.shells.size(); ++i) {
     if (!shell_has_contact(s, i)) continue;
-    g = std::max(g, s.shell_materials[static_cast<std::size_t>(s.shells[i].material)].thickness);
+    const ShellMaterialDesc& m = s.shell_materials[static_cast<std::size_t>(s.shells[i].material)];
+    g = std::max(g, m.contact_thickness.value_or(m.thickness));
   }
   return g;
 }
