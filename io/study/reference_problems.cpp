@@ -1,5 +1,6 @@
 // The reference problems of the accuracy study (docs/accuracy.md). Each reference is
 // computed from the scene as run, so a sweep that changes a parameter keeps its answer.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -471,6 +472,56 @@ ReferenceProblem drape_sphere() {
   return p;
 }
 
+/// n sheets of thickness t dropped on the ground settle to a pile n t tall (contact at the
+/// real distance; the grid's stencils alone held each sheet cells above the one below).
+ReferenceProblem stack_height() {
+  ReferenceProblem p;
+  p.name = "stack_height";
+  p.title = "Four 2 mm sheets dropped on the ground: height of the pile";
+  p.quantity = "the top sheet's upper surface over the ground";
+  p.unit = "m";
+  p.reference_source = "n sheets of thickness t stand n t tall";
+  p.reference = [](const Scene& s) {
+    double h = 0;
+    for (const ShellDesc& d : s.shells) h += material_of(s, d).thickness;
+    return h;
+  };
+  p.measure = [](const RunFolder& r, const Scene& s) {
+    double top = -INFINITY;
+    for (const ShellDesc& d : s.shells) {
+      std::vector<double> y;
+      for (const Vec3d& x : r.shell_vertices(d.name, r.last_frame()))
+        if (std::hypot(x.x(), x.z()) < 0.06) y.push_back(x.y());
+      if (y.empty()) continue;
+      std::nth_element(y.begin(), y.begin() + std::ptrdiff_t(y.size() / 2), y.end());
+      top = std::max(top, y[y.size() / 2] + 0.5 * material_of(s, d).thickness);
+    }
+    return top - s.colliders.at(0).shape.point.y();
+  };
+  StudySweep dx;
+  dx.name = "grid spacing";
+  dx.varied = "shot.dx, with the sheets' mesh spacing equal to dx";
+  dx.held = "CFL 0.5, contact at the surfaces";
+  dx.refinement = true;
+  for (double h : {0.05, 0.025, 0.0125}) {
+    const int n = static_cast<int>(std::lround(0.3 / h));
+    std::vector<std::string> o = {"shot.dx=" + num(h)};
+    for (int k = 0; k < 4; ++k)
+      o.push_back("shells[" + std::to_string(k) + "].geometry.resolution=[" + std::to_string(n) +
+                  ", " + std::to_string(n) + "]");
+    dx.settings.push_back({"dx=" + num(h), o, h});
+  }
+  p.sweeps.push_back(dx);
+  StudySweep at;
+  at.name = "contact distance";
+  at.varied = "shot.contact_at: surface (the bodies' surfaces) or stencil (the paper's)";
+  at.held = "dx 0.025";
+  for (const char* w : {"surface", "stencil"})
+    at.settings.push_back({w, {std::string("shot.contact_at=") + w}, 0});
+  p.sweeps.push_back(at);
+  return p;
+}
+
 /// The quality presets (shot.quality, io/scene_quality.h) as one more sweep.
 StudySweep quality_sweep() {
   StudySweep w;
@@ -489,7 +540,8 @@ StudySweep quality_sweep() {
 std::vector<ReferenceProblem> reference_problems() {
   std::vector<ReferenceProblem> all = {
       plate(),         cantilever_static(), cantilever_vibration(), incline_collider(),
-      incline_sheet(), sand_column(),       bar_impact(),           drape_sphere()};
+      incline_sheet(), sand_column(),       bar_impact(),           drape_sphere(),
+      stack_height()};
   // The cantilevers' clamp is built for each resolution (cantilever_mesh), which a preset's
   // scaled resolution would not follow: they have no preset sweep.
   for (ReferenceProblem& p : all)
