@@ -40,7 +40,10 @@ struct LocalSlurm {
   bool up = false;
   std::string log;
   explicit LocalSlurm(const std::string& r) : root(r) {
-    const CmdResult c = run_command("sh " + kScript + " start " + root + " 2");
+    // Ports of their own (two test runs at once), from the process id.
+    const int port = 20000 + 2 * (static_cast<int>(getpid()) % 10000);
+    const CmdResult c =
+        run_command("sh " + kScript + " start " + root + " 2 " + std::to_string(port));
     log = c.output;
     up = c.code == 0;
     if (up) setenv("SLURM_CONF", (root + "/slurm.conf").c_str(), 1);
@@ -84,7 +87,7 @@ bool running_past(const TempDir& d, int i, const std::string& id, int frame) {
 TEST_CASE(
     "batch on a real single-node Slurm: a requeued and a preempted task finish "
     "byte-identical to a local batch; previews after the array; status and collect",
-    "[farm][slurm][slow]") {
+    "[farm][slurm]") {
   const std::string missing = slurm_missing();
   if (!missing.empty()) {
     WARN("skipped: no single-node Slurm here: " << missing);
@@ -116,8 +119,15 @@ TEST_CASE(
   const CmdResult requeue = run_command("scontrol requeue " + job + "_0");
   INFO(requeue.output);
   CHECK(requeue.code == 0);
-  // Preempt task 1: a job in "high" wants both cores.
-  REQUIRE(wait_until(120, [&] { return running_past(d, 1, "soft/velocity-0_-1_0", 3); }));
+  // Preempt another running task: a job in "high" wants both cores.
+  const char* const ids[] = {"soft/velocity-0_0_0", "soft/velocity-0_-1_0", "stiff/velocity-0_0_0",
+                             "stiff/velocity-0_-1_0"};
+  int preempted = -1;
+  REQUIRE(wait_until(120, [&] {
+    for (int i = 1; i < 4 && preempted < 0; ++i)
+      if (running_past(d, i, ids[i], 3)) preempted = i;
+    return preempted > 0;
+  }));
   const CmdResult high =
       run_command("sbatch --parsable -p high -c 2 --mem 10M -o /dev/null --wrap 'sleep 2'");
   INFO(high.output);
@@ -135,9 +145,10 @@ TEST_CASE(
   INFO(s.dump(1));
   INFO(read_text(d.file("out/_farm/logs/task.0000.log")));
   INFO(read_text(d.file("out/_farm/logs/task.0001.log")));
+  INFO("preempted task " << preempted);
   REQUIRE(finished);
   CHECK(s["tasks"][0]["restarts"].get<int>() >= 1);
-  CHECK(s["tasks"][1]["restarts"].get<int>() >= 1);
+  CHECK(s["tasks"][preempted]["restarts"].get<int>() >= 1);
   const std::string log0 = read_text(d.file("out/_farm/logs/task.0000.log"));
   CHECK(log0.find("attempt 2 on") != std::string::npos);  // appended, not truncated
   CHECK(log0.find("attempt 1 on") != std::string::npos);

@@ -2,14 +2,16 @@
 # A single-node Slurm on this machine, for tests and trying `shellmpm batch submit`:
 # munged, slurmctld and slurmd as root without systemd, their configuration, state and logs
 # under ROOT, two partitions (low, and high, which preempts low by requeueing it).
-#   tools/farm/slurm-local.sh start ROOT [CPUS]   prints `export SLURM_CONF=ROOT/slurm.conf`
+#   tools/farm/slurm-local.sh start ROOT [CPUS [PORT]]
+#       prints `export SLURM_CONF=ROOT/slurm.conf`; PORT (default 6817) and PORT+1 are the
+#       controller's and the node daemon's (two clusters at once need their own)
 #   tools/farm/slurm-local.sh stop ROOT           cancels every job, stops the daemons by PID
 # Needs Debian 12's slurm-wlm and munge (tools/install-deps.sh). The recipe and its pitfalls:
 # docs/farm.md, "A single-node Slurm".
 set -eu
 cmd=${1:-}
 root=${2:-}
-[ -n "$cmd" ] && [ -n "$root" ] || { echo "usage: $0 start|stop ROOT [CPUS]" >&2; exit 2; }
+[ -n "$cmd" ] && [ -n "$root" ] || { echo "usage: $0 start|stop ROOT [CPUS [PORT]]" >&2; exit 2; }
 conf="$root/slurm.conf"
 
 stop_pid() {  # stop_pid PIDFILE: TERM, wait up to 10 s, then KILL
@@ -25,6 +27,7 @@ stop_pid() {  # stop_pid PIDFILE: TERM, wait up to 10 s, then KILL
 case "$cmd" in
 start)
   cpus=${3:-$(nproc)}
+  port=${4:-6817}
   host=$(hostname -s)
   for tool in munged mungekey slurmctld slurmd sinfo runuser; do
     command -v "$tool" >/dev/null 2>&1 || [ -x "/usr/sbin/$tool" ] ||
@@ -44,6 +47,8 @@ start)
 # Single-node Slurm for tests: no systemd, no cgroups, root only (tools/farm/slurm-local.sh).
 ClusterName=shellmpm
 SlurmctldHost=localhost
+SlurmctldPort=$port
+SlurmdPort=$((port + 1))
 SlurmUser=root
 SlurmdUser=root
 AuthType=auth/munge
@@ -101,7 +106,7 @@ stop)
   stop_pid "$root/munge/munged.pid"
   ;;
 *)
-  echo "usage: $0 start|stop ROOT [CPUS]" >&2
+  echo "usage: $0 start|stop ROOT [CPUS [PORT]]" >&2
   exit 2
   ;;
 esac
