@@ -126,7 +126,7 @@ void LocalEngine::start(Job j) {
       std::to_string(threads_), "--engine", "local"};
   if (j.preview) argv.push_back("--preview");
   if (o_.force && !j.preview) argv.push_back("--force");
-  j.pid = spawn_process(argv, log_path(b_, t.index));
+  j.pid = spawn_process(argv, log_path(b_, t.index), true);
   j.start = unix_now();
   running_.push_back(j);
   std::string what = j.preview ? "preview" : "start";
@@ -228,7 +228,7 @@ int LocalEngine::run() {
                 b_.name.c_str(), n, queue_.size(),
                 skipped_ ? (", " + std::to_string(skipped_) + " done already").c_str() : "", slots_,
                 threads_, threads_ == 1 ? "" : "s", cores);
-  SignalRelay relay;
+  SignalRelay relay(SignalRelay::Mode::Every);
   t0_ = unix_now();
   auto last_draw = std::chrono::steady_clock::now();
   while (!queue_.empty() || !running_.empty()) {

@@ -56,8 +56,7 @@ std::string find_program(const std::string& name) {
   return "";
 }
 
-pid_t spawn_process(const std::vector<std::string>& argv, const std::string& log,
-                    const std::vector<std::string>& env) {
+pid_t spawn_process(const std::vector<std::string>& argv, const std::string& log, bool own_group) {
   int fd = -1;
   if (!log.empty()) {
     fs::create_directories(fs::path(log).parent_path());
@@ -66,7 +65,6 @@ pid_t spawn_process(const std::vector<std::string>& argv, const std::string& log
   }
   std::vector<std::string> args = argv;
   std::vector<char*> cargs = c_strings(args);
-  std::vector<std::string> envs = env;
   const pid_t pid = fork();
   if (pid < 0) throw std::system_error(errno, std::generic_category(), "fork");
   if (pid == 0) {
@@ -74,10 +72,7 @@ pid_t spawn_process(const std::vector<std::string>& argv, const std::string& log
       dup2(fd, 1);
       dup2(fd, 2);
     }
-    for (std::string& e : envs) putenv(e.data());
-    // Its own process group: a terminal's Ctrl-C reaches the parent alone, which passes it
-    // on once (a second signal would stop `shellmpm run` without its checkpoint).
-    setpgid(0, 0);
+    if (own_group) setpgid(0, 0);
     reset_signals();
     execv(cargs[0], cargs.data());
     _exit(127);

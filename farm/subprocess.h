@@ -16,12 +16,11 @@ namespace shellmpm {
 std::string find_program(const std::string& name);
 
 /// Starts argv[0] (a path) with argv. Its stdout and stderr are appended to `log` (created
-/// with its folder), or inherited when `log` is empty. `env` ("NAME=value") are added to its
-/// environment. SIGTERM and SIGINT are restored to their defaults in the child, which gets a
-/// process group of its own (signals reach it through the parent).
+/// with its folder), or inherited when `log` is empty. SIGTERM and SIGINT are restored to their
+/// defaults in the child. With `own_group` it gets a process group of its own (a terminal's Ctrl-C
+/// reaches the parent alone, which passes it on).
 /// @throws std::system_error when fork fails or the log cannot be opened.
-pid_t spawn_process(const std::vector<std::string>& argv, const std::string& log,
-                    const std::vector<std::string>& env = {});
+pid_t spawn_process(const std::vector<std::string>& argv, const std::string& log, bool own_group);
 
 /// Waits for `pid`. Returns its exit code, 128 + the signal when a signal ended it, or
 /// -1 when `nohang` and it is still running. A failed exec exits 127.

@@ -96,7 +96,8 @@ class TaskLock {
 /// Runs argv as this task's step, relaying signals; returns its exit code.
 int run_step(const std::vector<std::string>& argv, SignalRelay& relay) {
   if (SignalRelay::pending() != 0) return 128 + SignalRelay::pending();
-  const pid_t pid = spawn_process(argv, "");
+  // In this process's group: whatever kills the task's process tree reaches the run too.
+  const pid_t pid = spawn_process(argv, "", false);
   relay.add(pid);
   const int code = wait_process(pid, false);
   relay.remove(pid);
@@ -182,7 +183,8 @@ int run_batch_task(const BatchSpec& b, const std::vector<BatchTask>& tasks, int 
                         std::to_string(tasks.size()) + " (0-" + std::to_string(tasks.size() - 1) +
                         ")");
   const BatchTask& t = tasks[index];
-  SignalRelay relay;  // from the start: a stop before the run starts is one too
+  // From the start: a stop before the run starts is one too.
+  SignalRelay relay(SignalRelay::Mode::FirstSwapped);
   const TaskLock lock(b, index, 120);
   TaskStatus st = load_status(b, t);
   st.host = short_hostname();
