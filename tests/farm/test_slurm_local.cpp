@@ -152,6 +152,10 @@ TEST_CASE(
   const std::string log0 = read_text(d.file("out/_farm/logs/task.0000.log"));
   CHECK(log0.find("attempt 2 on") != std::string::npos);  // appended, not truncated
   CHECK(log0.find("attempt 1 on") != std::string::npos);
+  // The requeue's SIGTERM reached the run directly and through `batch task`, and it still
+  // stopped once, after its frame, with a checkpoint; the second attempt resumed from it.
+  CHECK(log0.find("stopped by SIG") != std::string::npos);
+  CHECK(log0.find("resuming after frame") != std::string::npos);
 
   // The previews ran after every task of the array had finished.
   double last_sim = 0, first_preview = 1e300;
