@@ -58,11 +58,18 @@ inline Real surface_distance_from_share(Real phi) {
   return std::clamp(s, Real(0), Real(0.5));
 }
 
+/// Share of an overlap between two contact surfaces the pair rule undoes per step.
+constexpr Real kOverlapRecovery = Real(0.25);
+
 /// The normal velocity two bodies may still close at within a step of dt [s] when their
-/// contact surfaces are `gap` [m] apart at its start: gap / dt, none (0) once they touch
-/// or overlap. field_contact's `allow`.
+/// contact surfaces are `gap` [m] apart at its start: gap / dt while apart; once they
+/// overlap, minus a quarter of the overlap per step (they separate at least that fast, so
+/// an overlap left by one step's round-off or a node's estimate does not accumulate into a
+/// creep through the other body; the shell guard stays the backstop). field_contact's
+/// `allow`; 0 where the gap is not finite (contact at the stencils).
 inline Real closing_allowance(Real gap, Real dt) {
-  return gap > 0 && dt > 0 ? gap / dt : Real(0);
+  if (!(dt > 0) || !std::isfinite(gap)) return Real(0);
+  return gap > 0 ? gap / dt : kOverlapRecovery * gap / dt;
 }
 
 }  // namespace shellmpm

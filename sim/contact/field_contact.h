@@ -23,12 +23,12 @@ inline Real inverse_field_mass(Real m, Real held) {
 
 /// Fields a and b at one node: n the unit normal from a towards b, wa and wb their
 /// inverse masses (0: pinned, infinitely heavy), va and vb their velocities. When they
-/// approach along n faster than `allow` [m/s] (0: not at all; contact_gap.h: the gap
-/// between their contact surfaces over the step), their relative normal velocity becomes
-/// -allow, and their relative tangential velocity drops by `friction` times the normal
-/// velocity removed (sticking at zero); the momentum changes are equal and opposite.
-/// Separating fields, and fields closing slower than `allow`, keep theirs. Returns whether
-/// the rule acted (the bodies touch within the step).
+/// approach along n faster than `allow` [m/s] (0: not at all; negative: they must separate
+/// at least that fast; contact_gap.h: the gap between their contact surfaces over the
+/// step), their relative normal velocity becomes -allow, and their relative tangential velocity
+/// drops by `friction` times the normal velocity removed (sticking at zero); the momentum changes
+/// are equal and opposite. Separating fields, and fields closing slower than `allow`, keep theirs.
+/// Returns whether the rule acted (the bodies touch within the step).
 inline bool field_contact(const Vec3& n, Real friction, Real wa, Vec3& va, Real wb, Vec3& vb,
                           Real allow = 0) {
   const Real w = wa + wb;
@@ -38,10 +38,10 @@ inline bool field_contact(const Vec3& n, Real friction, Real wa, Vec3& va, Real 
   if (un + allow >= 0) return false;  // separating, or not closing the gap in this step
   Vec3 ut = u - un * n;
   const Real tl = ut.norm();
-  const Real drop = -friction * (un + allow);
+  const Real drop = -friction * (un + allow);  // the normal velocity removed, times c_F
   ut = tl <= drop ? Vec3::Zero() : Vec3(ut * (1 - drop / tl));
   // allow = 0 (touching) in the same operations as before the gap existed.
-  const Vec3 du = allow > 0 ? Vec3(ut - allow * n - u) : Vec3(ut - u);
+  const Vec3 du = allow != 0 ? Vec3(ut - allow * n - u) : Vec3(ut - u);
   va -= (wa / w) * du;
   vb += (wb / w) * du;
   return true;

@@ -369,7 +369,7 @@ bool ShellFields::shell_pairs(std::vector<Body>& bodies) const {
           if (!surfaces_) continue;
           // Level within round-off: touching at any contact thickness; no normal to
           // choose, so the rule waits for the next step.
-          A.touched = B.touched = acted = true;
+          acted = true;
           continue;
         }
         nab = h > 0 ? u : Vec3(-u);
@@ -381,8 +381,6 @@ bool ShellFields::shell_pairs(std::vector<Body>& bodies) const {
       const bool met = field_contact(nab, std::sqrt(friction_[A.shell] * friction_[B.shell]),
                                      A.winv, A.vel, B.winv, B.vel, closing_allowance(gap, dt_)) ||
                        gap <= 0;
-      A.touched = A.touched || met;
-      B.touched = B.touched || met;
       acted |= met;
     }
   return acted;
@@ -422,7 +420,6 @@ bool ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real m
     const bool met = field_contact(nb, friction_[B.shell], B.winv, B.vel, Real(1) / mk, vk,
                                    closing_allowance(gap, dt_)) ||
                      gap <= 0;
-    B.touched = B.touched || met;
     acted |= met;
   }
   return acted;
@@ -444,17 +441,11 @@ void ShellFields::resolve_node(const GridNode& cn, std::size_t g, int n, bool mo
   for (Body& B : bodies) body_geometry(B);
   // Shell against shell (facing across the node, or stacked on one side of it),
   // then each shell against the bulk field: Bardenhagen's rule.
-  bool acted = shell_pairs(bodies);
-  if (bulk) acted |= bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk);
+  shell_pairs(bodies);
+  if (bulk) bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk);
   for (const Body& B : bodies) *B.r = B.vel - v0;
   if (bulk) r_bulk_[g][n] = vk - v0;
   shared_[g] |= std::uint64_t(1) << n;
-  if (acted) {
-    const int* fb = fblock_.data() + g * fields_.size();
-    for (const Body& B : bodies)
-      if (B.touched)
-        fields_[std::size_t(B.shell)].touch[std::size_t(fb[B.shell])] |= std::uint64_t(1) << n;
-  }
   if (bulk) bulk_at_[g] |= std::uint64_t(1) << n;
 }
 
@@ -470,7 +461,6 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   find_field_blocks(combined, serial);
   r_bulk_.resize(ng);
   shared_.assign(ng, 0);
-  for (Field& F : fields_) F.touch.assign(F.nodes.size(), 0);
   bulk_at_.assign(ng, 0);
   dt_ = dt;
   dx_ = static_cast<Real>(combined.dx());
@@ -508,17 +498,14 @@ void ShellFields::apart_sites(const SparseGrid& combined, const ShellPointTable&
         combined.for_each_point(b, [&](std::uint32_t i) {
           if (i < first_site || i >= end) return;  // control points; bulk particles
           const QuadraticWeights W(combined.grid_coord(points[i]));
-          const std::size_t s = table.shell(i), K = fields_.size();
-          const Field& F = fields_[s];
-          // Apart: some node of the stencil is shared with a body the shell does not touch.
+          const std::size_t s = table.shell(i);
+          // Apart from the grid's own rule: some node of the stencil is shared with another
+          // body (or the shell's other fold class).
           bool apart = false;
           for_each_stencil_node(W, bc, [&](const StencilNode& n) {
             const int g = nbr[(n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2)];
             if (apart || g < 0) return;
-            const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
-            if (!(shared_[std::size_t(g)] >> bn & 1)) return;
-            const int fb = fblock_[std::size_t(g) * K + s];
-            apart = !(fb >= 0 && (F.touch[std::size_t(fb)] >> bn & 1));
+            apart = shared_[std::size_t(g)] >> block_node(n.px & 3, n.py & 3, n.pz & 3) & 1;
           });
           if (apart) release[s][table.local(i)] = 1;
         });

@@ -67,15 +67,16 @@ class ShellFields {
     half_thickness_ = std::move(half_thickness);
   }
   /// With contact at the surfaces: marks the contact particles whose stencil holds a node
-  /// that their shell shares with a body it does not touch there (release[s][p] = 1 for
-  /// site p of grid shell s; others 0). A site reads the node's common velocity, so such a
-  /// site's normal column was squeezed by the other body's motion across a real gap, and
-  /// its normal force, applied to the node, would push that body a cell early (a sheet
-  /// falling on a pile stopped 0.75 dx above it). The return mapping treats it as
-  /// separated: contact between bodies is then the gated pair rule's (and the shell
-  /// guard's at the thickness), and the paper's contact elasticity acts where nothing
-  /// else shares the stencil (self-contact, colliders). points: the combined binning's
-  /// shell points (control points, then contact particles).
+  /// that their shell shares with another body (or its other fold class): release[s][p] =
+  /// 1 for site p of grid shell s, others 0. A site reads the node's common velocity, so it
+  /// was squeezed by the other body's motion across the gap between them, and its normal
+  /// force, applied to the node, pushed that body away a cell early (a sheet falling on a
+  /// pile stopped 0.75 dx above it; with a contact thickness of a cell, two). The return
+  /// mapping treats it as separated: between bodies, contact is the gated pair rule's
+  /// (Bardenhagen's Coulomb friction once it acts; the shell guard below the contact
+  /// distance as the backstop), and the paper's contact elasticity acts where no other
+  /// body shares the stencil (self-contact within a layer, colliders). points: the combined
+  /// binning's shell points (control points, then contact particles).
   void apart_sites(const SparseGrid& combined, const ShellPointTable& table,
                    const std::vector<Vec3>& points, std::vector<std::vector<std::uint8_t>>& release,
                    bool serial) const;
@@ -192,11 +193,8 @@ class ShellFields {
     /// heights_only_, where the shell folds: the combined P2G's heights on this grid.
     std::vector<std::array<NodeHeights, kBlockNodes>> heights;
     std::vector<std::array<Vec3, kBlockNodes>> r;  ///< velocity relative to the node
-    /// Per grid block, a bit per node: the shell (either class) touched another body there
-    /// in the last p2g (the rule acted on a pair with it, or their surfaces overlap).
-    std::vector<std::uint64_t> touch;
-    std::vector<Vec3> x0;      ///< control points at p2g time
-    std::vector<Vec3> normal;  ///< control-point unit normals
+    std::vector<Vec3> x0;                          ///< control points at p2g time
+    std::vector<Vec3> normal;                      ///< control-point unit normals
     /// The shell's triangles at each control point, ascending: tri_of[tri_start[i] ..
     /// tri_start[i + 1]) (built once).
     std::vector<std::uint32_t> tri_start, tri_of;
@@ -280,7 +278,6 @@ class ShellFields {
     Vec3* r;                  ///< where its relative velocity goes
     Vec3 vel, nrm, own, off;  ///< velocity, normal to the node, own normal, centroid
     Real winv;                ///< inverse effective mass (pinned share: infinite)
-    bool touched = false;     ///< the rule acted on a pair with it (or their surfaces overlap)
   };
   // Steps of p2g().
   /// fblock_, fielded_: each field's block at each combined grid block.

@@ -317,39 +317,74 @@ GapSummary summarise(std::vector<double>& g) {
 }
 }  // namespace
 
-/// Gaps between contact surfaces: every shell limit vertex against the nearest other
-/// shell and every collider, every bulk particle against the nearest shell.
+/// Gaps between contact surfaces: every shell limit vertex against its nearest other
+/// surface (another shell, a bulk particle's volume, a collider) within the band.
 void IntegrityMonitor::measure_gaps(const IntegrityView& view, IntegrityReport& r) const {
   const std::size_t nb = view.bulk ? view.bulk->size() : 0;
   const std::size_t nv = vertex_offset_.back();
   const auto half = [&view](std::size_t s) {
     return s < view.half_thickness.size() ? view.half_thickness[s] : 0.0;
   };
+  // Bulk particles by cell of the band's size (sorted keys: a deterministic lookup).
+  const double cell = band_;
+  const auto key_of = [cell](const Vec3d& x) {
+    const auto c = [cell](double v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / cell)) +
+                                        (1 << 20)) &
+             0x1fffff;
+    };
+    return c(x.x()) << 42 | c(x.y()) << 21 | c(x.z());
+  };
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;
+  cells.reserve(nb);
+  for (std::size_t p = 0; p < nb; ++p)
+    if (view.bulk->x[p].allFinite())
+      cells.push_back({key_of(view.bulk->x[p].cast<double>()), static_cast<std::uint32_t>(p)});
+  std::sort(cells.begin(), cells.end());
+  // The nearest bulk particle's surface: distance less half its spacing.
+  const auto nearest_bulk = [&](const Vec3d& x) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j)
+        for (int k = -1; k <= 1; ++k) {
+          const std::uint64_t key = key_of(x + cell * Vec3d(i, j, k));
+          auto it =
+              std::lower_bound(cells.begin(), cells.end(), std::make_pair(key, std::uint32_t(0)));
+          for (; it != cells.end() && it->first == key; ++it) {
+            const std::size_t p = it->second;
+            const double d = (view.bulk->x[p].cast<double>() - x).norm() -
+                             0.5 * std::cbrt(double(view.bulk->volume_of(p)));
+            best = std::min(best, d);
+          }
+        }
+    return best;
+  };
   struct Lists {
     std::vector<double> ss, sb, sc;
   };
-  const std::size_t n = shells_.empty() ? 0 : nv + nb;
   const std::vector<Lists> parts =
-      chunk_parts(n, kGrain, view.serial, Lists(), [&](std::size_t b, std::size_t e, Lists& l) {
+      chunk_parts(nv, kGrain, view.serial, Lists(), [&](std::size_t b, std::size_t e, Lists& l) {
         std::size_t s = 0;
         for (std::size_t i = b; i < e; ++i) {
           const Vec3d x = point(view, i, s);
           if (!x.allFinite()) continue;
-          const bool vertex = i < nv;
-          // A bulk particle's volume as a sphere of half its spacing.
-          const double own =
-              vertex ? half(s) : 0.5 * std::cbrt(double(view.bulk->volume_of(i - nv)));
-          const auto [d, other] = nearest_shell(x, vertex ? static_cast<int>(s) : -1);
-          if (other >= 0) (vertex ? l.ss : l.sb).push_back(d - own - half(std::size_t(other)));
-          if (!vertex || !view.colliders) continue;
-          for (const Collider& c : *view.colliders) {
-            Aabb at;
-            at.lo = x.array() - band_;
-            at.hi = x.array() + band_;
-            if (!c.bounds().overlaps(at)) continue;
-            const double phi = c.phi(x);
-            if (phi < band_) l.sc.push_back(phi - own);
-          }
+          const double own = half(s);
+          const auto [d, other] = nearest_shell(x, static_cast<int>(s));
+          const double g_shell = other >= 0 ? d - own - half(std::size_t(other))
+                                            : std::numeric_limits<double>::infinity();
+          const double g_bulk =
+              nb ? nearest_bulk(x) - own : std::numeric_limits<double>::infinity();
+          double g_coll = std::numeric_limits<double>::infinity();
+          if (view.colliders)
+            for (const Collider& c : *view.colliders) {
+              Aabb at;
+              at.lo = x.array() - band_;
+              at.hi = x.array() + band_;
+              if (c.bounds().overlaps(at)) g_coll = std::min(g_coll, c.phi(x) - own);
+            }
+          const double g = std::min({g_shell, g_bulk, g_coll});
+          if (!(g < band_)) continue;
+          (g == g_shell ? l.ss : g == g_bulk ? l.sb : l.sc).push_back(g);
         }
       });
   Lists all;

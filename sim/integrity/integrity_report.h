@@ -28,11 +28,11 @@ struct IntegrityEvent {
   Vec3d where{0, 0, 0};  ///< a place where it happened (first crossing, deepest point)
 };
 
-/// Gaps between contact surfaces at the frame's end, over the points within the monitor's
-/// band (2 dx) of another body: each shell limit vertex or bulk particle counts its
-/// nearest other surface once. A gap is the distance between the surfaces (a shell's
-/// limit surface offset by half its contact thickness; bulk particles' volume, a sphere
-/// of half the particle spacing; a collider's level set); negative where they overlap.
+/// Gaps between contact surfaces at the frame's end: each shell limit vertex within the
+/// monitor's band (2 dx) of another body counts the gap to its nearest other surface once,
+/// under that surface's kind. A gap is the distance between the surfaces (a shell's limit
+/// surface offset by half its contact thickness; a bulk particle's volume, a sphere of half
+/// its spacing; a collider's level set); negative where they overlap.
 struct GapSummary {
   std::size_t count = 0;  ///< points within the band
   double min = 0;         ///< smallest gap [m]

@@ -62,7 +62,7 @@ struct ShotSettings {
   /// The shell guard (sim/contact/shell_guard.h): stops contact shells from closing
   /// closer than shell_guard_gap where the grid cannot hold them apart.
   bool shell_guard = true;
-  double shell_guard_gap = 0;  ///< [m]; 0: the larger of 0.05 dx and the thickest contact shell
+  double shell_guard_gap = 0;  ///< [m]; 0: ShellGuardStage::gap
   std::string units = "m";     ///< informational, written to VDB metadata
   Integrator integrator = Integrator::Explicit;
   /// Implicit: a Newton solve has converged when no velocity correction it asks for

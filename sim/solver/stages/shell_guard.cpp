@@ -1,6 +1,8 @@
 #include "sim/solver/stages/shell_guard.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "sim/solver/stages/scene_rules.h"
 
@@ -12,13 +14,19 @@ bool ShellGuardStage::needed(const Scene& s) {
 
 double ShellGuardStage::gap(const Scene& s) {
   if (s.shot.shell_guard_gap > 0) return s.shot.shell_guard_gap;
-  double g = 0.05 * s.shot.dx;
+  const bool surface = s.shot.contact_at == ContactAt::Surface;
+  // Stencil contact: the larger of 0.05 dx and the thickest contact shell. Surface contact
+  // holds bodies at their contact thickness on the grid, so the guard, a frictionless
+  // backstop, stays below it: half the thinnest contact layer (at the thickness it did
+  // the grid's work, 80% of a sheet pile's step, and without friction).
+  double g = surface ? std::numeric_limits<double>::infinity() : 0.05 * s.shot.dx;
   for (std::size_t i = 0; i < s.shells.size(); ++i) {
     if (!shell_has_contact(s, i)) continue;
     const ShellMaterialDesc& m = s.shell_materials[static_cast<std::size_t>(s.shells[i].material)];
-    g = std::max(g, m.contact_thickness.value_or(m.thickness));
+    const double c = m.contact_thickness.value_or(m.thickness);
+    g = surface ? std::min(g, 0.5 * c) : std::max(g, c);
   }
-  return g;
+  return std::isfinite(g) ? g : 0.05 * s.shot.dx;
 }
 
 void ShellGuardStage::run(StepContext& c) {
