@@ -106,7 +106,7 @@ std::vector<KeySpec> build_schema() {
           .rule("see docs/accuracy.md#quality-presets"),
       Spec("shot.shell_velocities", T::Enum).to(&ShotSettings::shell_velocities).def("per_shell"),
       Spec("shot.fold_fields", T::Bool).to(&ShotSettings::fold_fields).def("true"),
-      Spec("shot.contact_at", T::Enum).to(&ShotSettings::contact_at).def("surface"),
+      Spec("shot.contact_at", T::Enum).to(&ShotSettings::contact_at).def("stencil"),
       Spec("shot.shell_guard", T::Bool).to(&ShotSettings::shell_guard).def("true"),
       Spec("shot.shell_guard_gap", T::Number)
           .to(&ShotSettings::shell_guard_gap)
