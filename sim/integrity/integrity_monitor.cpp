@@ -320,8 +320,9 @@ GapSummary summarise(std::vector<double>& g) {
 /// Gaps between contact surfaces: every shell limit vertex against its nearest other
 /// surface (another shell, a bulk particle's volume, a collider) within the band.
 void IntegrityMonitor::measure_gaps(const IntegrityView& view, IntegrityReport& r) const {
-  const std::size_t nb = view.bulk ? view.bulk->size() : 0;
   const std::size_t nv = vertex_offset_.back();
+  if (nv == 0) return;  // no shell: nothing to measure
+  const std::size_t nb = view.bulk ? view.bulk->size() : 0;
   const auto half = [&view](std::size_t s) {
     return s < view.half_thickness.size() ? view.half_thickness[s] : 0.0;
   };

@@ -67,17 +67,19 @@ void StepContext::compute_collider_reach() {
   const bool shells = !grid_shells.empty();
   if (shells) {
     shell_table.velocities(grid_shells, reach_velocities);
-    if (shell_point_offsets.size() != shell_table.size()) {
+    // Contact at the surfaces: each shell point reaches half its contact thickness further.
+    if (scene.shot.contact_at == ContactAt::Surface &&
+        shell_point_offsets.size() != shell_table.size()) {
       shell_point_offsets.resize(shell_table.size());
       for (std::uint32_t i = 0; i < shell_table.size(); ++i)
         shell_point_offsets[i] =
             static_cast<Real>(contact_offset(*grid_shells[shell_table.shell(i)].shell));
     }
   }
-  collider_reach.compute(grid, shells ? &shell_points : nullptr,
-                         shells ? &reach_velocities : nullptr, particles.x, particles.v, colliders,
-                         kColliderReachCells * grid.dx(), dt, opt.serial,
-                         shells ? &shell_point_offsets : nullptr);
+  collider_reach.compute(
+      grid, shells ? &shell_points : nullptr, shells ? &reach_velocities : nullptr, particles.x,
+      particles.v, colliders, kColliderReachCells * grid.dx(), dt, opt.serial,
+      shells && scene.shot.contact_at == ContactAt::Surface ? &shell_point_offsets : nullptr);
 }
 
 bool StepContext::wall_node(const Vec3i& n) const {
