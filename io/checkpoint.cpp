@@ -182,6 +182,19 @@ void parse_payload(Cursor& in, Checkpoint& c) {
     if (p.id[i] >= p.next_id)
       in.fail("particle id[" + std::to_string(i) + "] is not below next id " +
               std::to_string(p.next_id));
+    // A deformation gradient no step can produce: inverted or collapsed.
+    const double det = static_cast<double>(p.F[i].determinant());
+    if (!(det > 0))
+      in.fail("particle " + std::to_string(i) + " (id " + std::to_string(p.id[i]) +
+              ") has a deformation gradient of determinant " + std::to_string(det) +
+              " (not positive)");
+  }
+  {
+    // Ids are unique: every particle is given the next one when it is made.
+    std::vector<std::uint32_t> ids(p.id);
+    std::sort(ids.begin(), ids.end());
+    const auto twin = std::adjacent_find(ids.begin(), ids.end());
+    if (twin != ids.end()) in.fail("two particles have id " + std::to_string(*twin));
   }
   const auto len = in.get<std::uint64_t>("statistics length");
   if (len > in.left()) in.fail("statistics claim more bytes than the file holds");
@@ -215,6 +228,9 @@ void parse_payload(Cursor& in, Checkpoint& c) {
     require_finite(in, sh.plastic, name + " plastic state");
     require_finite(in, sh.C, name + " APIC matrix");
     require_finite(in, sh.a3e, name + " contact normal");
+    for (std::size_t k = 0; k < sh.a3e.size(); ++k)
+      if (!(sh.a3e[k].squaredNorm() > 0))
+        in.fail(name + " contact particle " + std::to_string(k) + " has a zero normal column");
   }
   if (in.left() != 0) in.fail(std::to_string(in.left()) + " unexpected bytes after the shells");
 }
@@ -321,6 +337,31 @@ void restore_checkpoint(Solver& solver, Checkpoint&& c, const std::string& path)
   if (p.keep_plastic != solver.particles().keep_plastic)
     throw refuse(p.keep_plastic ? "it has plastic state the scene's materials do not use"
                                 : "it has no plastic state, the scene's materials need one");
+  // Where no run could have left anything: bulk particles are kept inside the domain, and
+  // a shell farther out than the domain's own size from it has left it long ago.
+  const Vec3d lo = scene.shot.domain_min, hi = scene.shot.domain_max;
+  const auto where = [](const Vec3& x) {
+    std::ostringstream os;
+    os << "(" << x.x() << ", " << x.y() << ", " << x.z() << ")";
+    return os.str();
+  };
+  const auto outside = [](const Vec3& x, const Vec3d& a, const Vec3d& b) {
+    for (int k = 0; k < 3; ++k)
+      if (!(double(x[k]) >= a[k] && double(x[k]) <= b[k])) return true;
+    return false;
+  };
+  const double pad = scene.shot.dx;
+  for (std::size_t i = 0; i < p.x.size(); ++i)
+    if (outside(p.x[i], lo - Vec3d::Constant(pad), hi + Vec3d::Constant(pad)))
+      throw CheckpointDamaged(path, "particle " + std::to_string(i) + " (id " +
+                                        std::to_string(p.id[i]) + ") is at " + where(p.x[i]) +
+                                        ", outside the scene's domain");
+  for (std::size_t s = 0; s < c.shells.size(); ++s)
+    for (std::size_t j = 0; j < c.shells[s].x.size(); ++j)
+      if (outside(c.shells[s].x[j], lo - (hi - lo), hi + (hi - lo)))
+        throw CheckpointDamaged(path, "shell " + std::to_string(s) + " point " + std::to_string(j) +
+                                          " is at " + where(c.shells[s].x[j]) +
+                                          ", far outside the scene's domain");
   const double expected = frame_time(c.frame, scene.shot.fps);
   if (!(std::abs(c.time - expected) <= 0.5 / scene.shot.fps))
     throw refuse("its time " + std::to_string(c.time) + " s is not that of frame " +

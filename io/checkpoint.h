@@ -52,7 +52,9 @@ void save_shells(const Solver& solver, Checkpoint& c);
 
 /// Checks that checkpoint `c`, read from `path`, fits `solver` (built from the same scene):
 /// material indices within the material table, plastic state where the materials need
-/// it, the shells' sizes, and a time that belongs to its frame; then moves the particles,
+/// it, the shells' sizes, a time that belongs to its frame, and positions no run leaves
+/// (CheckpointDamaged: a particle outside the domain, a shell point farther from it than
+/// the domain's size); then moves the particles,
 /// shells and time into the solver. Throws UserError naming `path` when it does not fit
 /// (e.g. a mesh file changed since the checkpoint was written).
 void restore_checkpoint(Solver& solver, Checkpoint&& c, const std::string& path);
@@ -62,7 +64,8 @@ void restore_checkpoint(Solver& solver, Checkpoint&& c, const std::string& path)
 void write_checkpoint(const std::string& path, const Checkpoint& c);
 /// Reads a checkpoint and checks it (see the file layout above): throws CheckpointDamaged
 /// naming the file when it cannot be opened, is not a checkpoint, is damaged or holds
-/// impossible values (non-finite numbers, non-positive volumes, ids past next_id, frame
+/// impossible values (non-finite numbers, non-positive volumes, ids past next_id or used
+/// twice, deformation gradients of non-positive determinant, zero contact normals, frame
 /// < 1), and UserError when it was written by a build of another precision.
 Checkpoint read_checkpoint(const std::string& path);
 

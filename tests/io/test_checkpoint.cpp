@@ -235,6 +235,28 @@ TEST_CASE("values no run writes are refused even under a valid checksum", "[chec
     b.particles.id[2] = b.particles.next_id;
     expect_refused(dir, b, "particle id[2]");
   }
+  // Finite but impossible (a file crafted with a valid checksum, or one a farm node
+  // damaged before its checksum was taken).
+  {
+    Checkpoint b = small_checkpoint();
+    b.particles.F[1] = Mat3::Zero();
+    expect_refused(dir, b, "particle 1 (id 1) has a deformation gradient of determinant 0");
+  }
+  {
+    Checkpoint b = small_checkpoint();
+    b.particles.F[2](0, 0) = -b.particles.F[2](0, 0);  // inverted
+    expect_refused(dir, b, "particle 2 (id 2) has a deformation gradient of determinant -");
+  }
+  {
+    Checkpoint b = small_checkpoint();
+    b.particles.id[2] = b.particles.id[0];
+    expect_refused(dir, b, "two particles have id 0");
+  }
+  {
+    Checkpoint b = small_checkpoint();
+    b.shells[0].a3e[1] = Vec3::Zero();
+    expect_refused(dir, b, "shell 0 contact particle 1 has a zero normal column");
+  }
   {
     Checkpoint b = small_checkpoint();
     b.particles.plastic.clear();  // a plastic set without its plastic state
@@ -316,6 +338,21 @@ TEST_CASE("a checkpoint that does not fit its scene is refused before the solver
           c.particles.keep_plastic = true;
           c.particles.plastic.assign(c.particles.size(), 1);
         }).find("plastic state the scene's materials do not use") != std::string::npos);
+  // Positions no run leaves: a particle outside the domain (or at 1e30 m), a shell point
+  // a million metres away; the message names the file and the value.
+  const std::string far = refusal([](Checkpoint& c) { c.particles.x[0] = Vec3::Constant(1e30f); });
+  CHECK(far.find(path) != std::string::npos);
+  CHECK(far.find("particle 0 (id ") != std::string::npos);
+  CHECK(far.find("is at (1e+30, 1e+30, 1e+30), outside the scene's domain") != std::string::npos);
+  CHECK(refusal([](Checkpoint& c) {
+          Checkpoint::ShellState sh;
+          sh.x = {Vec3(Real(1e6), 0, 0)};
+          c.shells.push_back(sh);
+        }).find("shell 0 point 0 is at (1e+06, 0, 0), far outside the scene's domain") !=
+        std::string::npos);
+  CHECK(refusal([](Checkpoint& c) {
+          c.particles.x[1].y() = -3;
+        }).find("outside the scene's domain") != std::string::npos);
   // The frame field says 1000, the time is frame 3's: nothing would be simulated.
   CHECK(refusal([](Checkpoint& c) { c.frame = 1000; }).find("is not that of frame 1000") !=
         std::string::npos);

@@ -72,6 +72,17 @@ inline ColliderDesc sphere_collider(const std::string& name, const Vec3d& center
 }
 
 /// A scene for contact tests: grid spacing dx, CFL 0.5, 48 fps, the domain [-1, 1]^3.
+/// A square procedural sheet `size` m across with res x res cells, lifted to `at`.
+inline ShellDesc square_sheet(const std::string& name, double size, int res, const Vec3d& at) {
+  ShellDesc d;
+  d.name = name;
+  d.kind = ShellDesc::Kind::Sheet;
+  d.size[0] = d.size[1] = size;
+  d.resolution[0] = d.resolution[1] = res;
+  d.translate = at;
+  return d;
+}
+
 inline Scene contact_test_scene(double dx) {
   Scene s;
   s.path = "test";

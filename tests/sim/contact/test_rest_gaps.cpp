@@ -28,13 +28,7 @@ ShellMaterialDesc felt() {
 }
 
 ShellDesc sheet(const std::string& name, double size, int res, const Vec3d& at) {
-  ShellDesc d;
-  d.name = name;
-  d.kind = ShellDesc::Kind::Sheet;
-  d.size[0] = d.size[1] = size;
-  d.resolution[0] = d.resolution[1] = res;
-  d.translate = at;
-  return d;
+  return test::square_sheet(name, size, res, at);
 }
 
 Scene base_scene(double dx) {
