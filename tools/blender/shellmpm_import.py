@@ -4,7 +4,8 @@
 #
 # Command line (starts from an empty scene):
 #   blender -b -P tools/blender/shellmpm_import.py -- RUNDIR [--render OUT.png --frame N
-#       --samples S] [--hide-volume] [--summary OUT.json] [--save OUT.blend] ...
+#       --samples S] [--bulk fog|surface] [--hide-volume] [--summary OUT.json]
+#       [--save OUT.blend] ...
 # Add-on: Edit > Preferences > Add-ons > Install... this file, enable it, then
 #   File > Import > shellmpm run (run.json).
 #
@@ -12,6 +13,11 @@
 # attribute) a frame-change handler replaces from the PLY of the current frame: the caches
 # keep the vertex count and order every frame, so the object, its UVs, materials and
 # modifiers stay as they are and only the coordinates change.
+#
+# Bulk material (the density VDB sequence) loads as a fog volume (Principled Volume: smoke-
+# like in Cycles) or, with bulk="surface" (--bulk surface), as its iso-surface: a mesh object
+# whose Volume to Mesh modifier meshes the volume object's `density` grid at the preview
+# renderer's iso level (render.iso_value, 0.5) every frame, with an opaque sand material.
 
 import argparse
 import json
@@ -40,6 +46,14 @@ PROP_PATTERN = "shellmpm_pattern"  # the shell's mesh pattern, relative to the r
 PROP_FRAMES = "shellmpm_frames"  # [first, last] frames of the run
 PROP_FPS = "shellmpm_fps"  # the run's frames per second
 PROP_LOADED = "shellmpm_loaded_frame"  # the frame whose positions the mesh holds
+
+# Bulk material: how it loads, and the iso level of its surface. 0.5 is render.iso_value's
+# default (io/scene_schema_table.cpp), the level at which the preview renderer draws the
+# density's surface (render/scene_assembler.cpp iso_surface, OpenVDB volumeToMesh).
+BULK_MODES = ("fog", "surface")
+DEFAULT_ISO_VALUE = 0.5
+# The preview's default sand colour (render/scene_assembler.cpp default_bulk_color).
+SAND_COLOR = (0.76, 0.60, 0.38)
 
 # Scene coordinates (Y up) to Blender's (Z up): +90 degrees about X, (x, y, z) -> (x, -z, y),
 # the same rotation as Blender's glTF and OBJ importers' "Y forward / Z up" defaults.
@@ -374,6 +388,22 @@ def volume_material(name, extinction):
     return mat
 
 
+def surface_material(name, color):
+    """Opaque, rough Principled BSDF for the bulk surface (sand, snow, solids): `color` is
+    the base colour (linear RGB), no specular sheen to speak of."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    bsdf = mat.node_tree.nodes.get("Principled BSDF")
+    bsdf.inputs["Base Color"].default_value = (*color, 1.0)
+    bsdf.inputs["Roughness"].default_value = 0.9
+    # "Specular" in Blender 3.x (4.0 renamed it "Specular IOR Level").
+    spec = bsdf.inputs.get("Specular") or bsdf.inputs.get("Specular IOR Level")
+    if spec is not None:
+        spec.default_value = 0.2
+    mat.diffuse_color = (*color, 1.0)
+    return mat
+
+
 # ---------------------------------------------------------------------------------------
 # Cameras
 
@@ -454,6 +484,54 @@ def _add_lights(scene, collection):
         bg.inputs["Strength"].default_value = 0.6
 
 
+def _half_voxel_shift(context, volume, grid, frame):
+    """The volume object's offset (in the caches' coordinates) that puts the grid's voxels
+    where shellmpm and OpenVDB put them. shellmpm's VDBs (io/density_vdb) hold the density
+    of the cell centred on voxel index i at i * voxel (OpenVDB's convention, as Houdini and
+    the preview's volumeToMesh read it); Blender 3.4 samples voxel i at (i + 1/2) * voxel
+    in Cycles, the viewport and the Volume to Mesh modifier (measured: a box of 5 voxels
+    renders, and meshes, half a voxel towards +x, +y, +z). Shifting the object back by half
+    a voxel along each index axis lines the fog and its surface up with the shell meshes.
+    Reads the grid's transform from `frame`'s file (the evaluated volume: the original
+    datablock has no frame to load); zero, reported, when it cannot be read."""
+    scene = context.scene
+    current = scene.frame_current
+    scene.frame_set(frame)
+    try:
+        ev = volume.evaluated_get(context.evaluated_depsgraph_get())
+        grids = ev.data.grids
+        grids.load()
+        g = grids.get(grid) or (grids[0] if len(grids) else None)
+        m = Matrix(g.matrix_object) if g is not None else None
+        error = grids.error_message or f"no grid '{grid}'"
+    finally:
+        scene.frame_set(current)
+    if m is None:
+        print(f"shellmpm: {volume.data.filepath}: {error}; no half-voxel shift")
+        return Vector((0.0, 0.0, 0.0))
+    return -0.5 * (m.to_3x3() @ Vector((1.0, 1.0, 1.0)))
+
+
+def _add_bulk_surface(collection, root, volume, grid, iso_value, adaptivity, color):
+    """A mesh object whose Volume to Mesh modifier meshes `grid` of the volume object
+    `volume` at density `iso_value` (the grid's own voxels, as the preview's volumeToMesh),
+    re-evaluated whenever the volume loads another frame."""
+    name = volume.name.replace("_density", "_surface")
+    mesh = bpy.data.meshes.new(name)
+    obj = bpy.data.objects.new(name, mesh)
+    obj.parent = root
+    mod = obj.modifiers.new("shellmpm iso-surface", "VOLUME_TO_MESH")
+    mod.object = volume
+    mod.grid_name = grid
+    mod.threshold = float(iso_value)
+    mod.resolution_mode = "GRID"
+    mod.adaptivity = float(adaptivity)
+    mod.use_smooth_shade = True
+    mesh.materials.append(surface_material(f"shellmpm_{name}", color))
+    collection.objects.link(obj)
+    return obj
+
+
 def import_run(
     context,
     rundir,
@@ -462,8 +540,27 @@ def import_run(
     load_cameras=True,
     add_lights=False,
     scene_settings=True,
+    bulk="fog",
+    iso_value=None,
+    adaptivity=0.0,
+    surface_color=None,
 ):
-    """Imports the run folder into context.scene; returns a summary dict (see summary())."""
+    """Imports the run folder into context.scene; returns a summary dict (see summary()).
+
+    Bulk material (the density VDB sequence, when `load_volume` and the run wrote one):
+    bulk="fog" loads it as a volume object with a Principled Volume material; bulk="surface"
+    as the iso-surface at density `iso_value` (None: the run's resolved.density.iso_value
+    when run.json has it, else 0.5, render.iso_value's default): a mesh object with a Volume
+    to Mesh modifier (grid resolution, `adaptivity` in [0, 1], 0 keeps every triangle) on
+    the volume object, which stays as its source, hidden in renders and drawn as bounds.
+    `surface_color` (linear RGB; default sand) colours the surface. `hide_volume` leaves the
+    bulk (fog or surface) out of renders."""
+    if bulk not in BULK_MODES:
+        raise ShellmpmError(f"bulk '{bulk}': expected one of {', '.join(BULK_MODES)}")
+    if iso_value is not None and not float(iso_value) > 0.0:
+        raise ShellmpmError(f"iso value {iso_value}: must be > 0 (a density)")
+    if not 0.0 <= float(adaptivity) <= 1.0:
+        raise ShellmpmError(f"adaptivity {adaptivity}: must be in [0, 1]")
     rundir = os.path.abspath(rundir)
     res = read_run(rundir)
     scene = context.scene
@@ -511,6 +608,7 @@ def import_run(
         shells.append(obj)
 
     volume = None
+    surface = None
     dens = res.get("density")
     if load_volume and dens:
         path = frame_file(rundir, dens["pattern"], first)
@@ -529,6 +627,22 @@ def import_run(
         volume.parent = root
         volume.hide_render = hide_volume
         collection.objects.link(volume)
+        volume.location = _half_voxel_shift(context, volume, dens.get("grid", "density"), first)
+        if bulk == "surface":
+            iso = iso_value if iso_value is not None else dens.get("iso_value", DEFAULT_ISO_VALUE)
+            surface = _add_bulk_surface(
+                collection,
+                root,
+                volume,
+                dens.get("grid", "density"),
+                iso,
+                adaptivity,
+                tuple(surface_color) if surface_color is not None else SAND_COLOR,
+            )
+            surface.hide_render = hide_volume
+            # The fog stays the modifier's source: evaluated, not rendered, drawn as a box.
+            volume.hide_render = True
+            volume.display_type = "BOUNDS"
 
     register_handler()
     for obj in shells:
@@ -554,19 +668,27 @@ def import_run(
     if add_lights:
         _add_lights(scene, collection)
     return {"rundir": rundir, "resolved": res, "shells": shells, "volume": volume,
-            "camera": camera, "root": root}  # fmt: skip
+            "surface": surface, "camera": camera, "root": root}  # fmt: skip
 
 
 def _content_bounds(context, shells, volume, res):
-    """Scene-coordinate box of the shells and the volume at the current frame (the domain
-    when there is nothing)."""
-    context.view_layer.update()
+    """Scene-coordinate box of the shells and the volume at the run's first and last frames
+    (bulk material often starts empty: a source that emits, or a pile that spreads); the
+    domain when there is nothing. Empty objects (a volume with no active voxels has a box of
+    zero size at its origin) are left out. Returns to the current frame."""
+    scene = context.scene
+    current = scene.frame_current
     to_scene = Y_UP_TO_Z_UP.inverted()
     pts = []
-    for obj in shells + ([volume] if volume is not None else []):
-        ev = obj.evaluated_get(context.evaluated_depsgraph_get())
-        for c in ev.bound_box:
-            pts.append(to_scene @ (obj.matrix_world @ Vector(c)))
+    for frame in sorted(set(res["frames"])):
+        scene.frame_set(frame)
+        depsgraph = context.evaluated_depsgraph_get()
+        for obj in shells + ([volume] if volume is not None else []):
+            corners = [Vector(c) for c in obj.evaluated_get(depsgraph).bound_box]
+            if max((c - corners[0]).length for c in corners) <= 0.0:
+                continue
+            pts.extend(to_scene @ (obj.matrix_world @ c) for c in corners)
+    scene.frame_set(current)
     if not pts:
         return res["domain"]["min"], res["domain"]["max"]
     lo = [min(p[i] for p in pts) for i in range(3)]
@@ -577,7 +699,8 @@ def _content_bounds(context, shells, volume, res):
 def summary(context, imported):
     """What was loaded, as JSON-ready data: frame range and fps, per shell the vertex count
     and world-space box, the volume's settings and its image-space box (pixels from the top
-    left) as seen from the scene camera."""
+    left) as seen from the scene camera, and with bulk="surface" the surface mesh's counts
+    and boxes ("surface"; null otherwise)."""
     from bpy_extras.object_utils import world_to_camera_view
 
     scene = context.scene
@@ -590,6 +713,7 @@ def summary(context, imported):
         "resolution": [scene.render.resolution_x, scene.render.resolution_y],
         "shells": [],
         "volume": None,
+        "surface": None,
         "camera": scene.camera.name if scene.camera else None,
     }
     for obj in imported["shells"]:
@@ -619,6 +743,7 @@ def summary(context, imported):
             "frame_offset": data.frame_offset,
             "frame_duration": data.frame_duration,
             "hidden": vol.hide_render,
+            "location": list(vol.location),
             "grids": [],
             "image_box": None,
         }
@@ -637,7 +762,67 @@ def summary(context, imported):
                 ys.append((1.0 - p.y) * h)
             info["image_box"] = [min(xs), min(ys), max(xs), max(ys)]
         out["volume"] = info
+    surf = imported.get("surface")
+    if surf is not None:
+        out["surface"] = _surface_summary(scene, depsgraph, surf)
     return out
+
+
+def _image_box(scene, obj, corners):
+    """Pixels (from the top left) of the box around `corners` (object space) in the camera."""
+    from bpy_extras.object_utils import world_to_camera_view
+
+    w, h = scene.render.resolution_x, scene.render.resolution_y
+    xs, ys = [], []
+    for c in corners:
+        p = world_to_camera_view(scene, scene.camera, obj.matrix_world @ Vector(c))
+        xs.append(p.x * w)
+        ys.append((1.0 - p.y) * h)
+    return [min(xs), min(ys), max(xs), max(ys)]
+
+
+def _surface_summary(scene, depsgraph, obj):
+    """The bulk surface at the current frame: its modifier's settings, the evaluated mesh's
+    vertex, face and triangle counts, its world-space box and its box in the image."""
+    mod = next(m for m in obj.modifiers if m.type == "VOLUME_TO_MESH")
+    info = {
+        "object": obj.name,
+        "source": mod.object.name if mod.object else None,
+        "grid": mod.grid_name,
+        "threshold": mod.threshold,
+        "resolution_mode": mod.resolution_mode,
+        "adaptivity": mod.adaptivity,
+        "hidden": obj.hide_render,
+        "material": obj.data.materials[0].name if len(obj.data.materials) else None,
+        "vertices": 0,
+        "faces": 0,
+        "triangles": 0,
+        "world_min": None,
+        "world_max": None,
+        "image_box": None,
+    }
+    ev = obj.evaluated_get(depsgraph)
+    mesh = ev.to_mesh()
+    try:
+        n = len(mesh.vertices)
+        info["vertices"] = n
+        info["faces"] = len(mesh.polygons)
+        totals = np.empty(len(mesh.polygons), dtype=np.int32)
+        mesh.polygons.foreach_get("loop_total", totals)
+        info["triangles"] = int(np.sum(totals - 2))
+        if n:
+            co = np.empty(3 * n, dtype=np.float32)
+            mesh.vertices.foreach_get("co", co)
+            co = co.reshape(-1, 3).astype(np.float64)
+            mw = np.array(ev.matrix_world)
+            world = co @ mw[:3, :3].T + mw[:3, 3]
+            info["world_min"] = world.min(0).tolist()
+            info["world_max"] = world.max(0).tolist()
+            if scene.camera is not None:
+                info["image_box"] = _image_box(scene, ev, ev.bound_box)
+    finally:
+        ev.to_mesh_clear()
+    return info
 
 
 def render_frame(scene, path, samples, threads):
@@ -663,7 +848,7 @@ def render_frame(scene, path, samples, threads):
 # Add-on: File > Import > shellmpm run
 
 try:
-    from bpy.props import BoolProperty, StringProperty
+    from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
     from bpy_extras.io_utils import ImportHelper
 
     class IMPORT_OT_shellmpm_run(bpy.types.Operator, ImportHelper):
@@ -675,7 +860,33 @@ try:
 
         filename_ext = ".json"
         filter_glob: StringProperty(default="run.json", options={"HIDDEN"})
-        load_volume: BoolProperty(name="Density volume", default=True)
+        load_volume: BoolProperty(
+            name="Bulk material", description="Load the density volumes", default=True
+        )
+        bulk: EnumProperty(
+            name="Bulk as",
+            description="How bulk material (the density VDB sequence) is loaded",
+            items=(
+                ("FOG", "Fog volume", "Volume object, Principled Volume material (smoke-like)"),
+                ("SURFACE", "Surface",
+                 "The density's iso-surface (Volume to Mesh modifier), opaque sand material"),
+            ),
+            default="FOG",
+        )  # fmt: skip
+        iso_value: FloatProperty(
+            name="Iso value",
+            description="Density of the surface (the preview's render.iso_value, 0.5)",
+            default=DEFAULT_ISO_VALUE,
+            min=1e-6,
+            soft_max=2.0,
+        )
+        adaptivity: FloatProperty(
+            name="Adaptivity",
+            description="Fewer triangles where the surface is flat (0: every triangle)",
+            default=0.0,
+            min=0.0,
+            max=1.0,
+        )
         load_cameras: BoolProperty(name="Cameras", default=True)
         scene_settings: BoolProperty(
             name="Frame range, fps, size", description="Set the scene's from the run", default=True
@@ -690,6 +901,9 @@ try:
                     context,
                     rundir,
                     load_volume=self.load_volume,
+                    bulk=self.bulk.lower(),
+                    iso_value=self.iso_value,
+                    adaptivity=self.adaptivity,
                     load_cameras=self.load_cameras,
                     add_lights=self.add_lights,
                     scene_settings=self.scene_settings,
@@ -733,7 +947,26 @@ def _parse_args(argv):
     p.add_argument("--samples", type=int, default=16, help="Cycles samples per pixel (16)")
     p.add_argument("--size", metavar="WxH", help="image size (default: the scene's render.size)")
     p.add_argument("--threads", type=int, default=0, help="render threads (0: all)")
-    p.add_argument("--hide-volume", action="store_true", help="load the volume, hidden in renders")
+    p.add_argument(
+        "--bulk",
+        choices=BULK_MODES,
+        default="fog",
+        help="bulk material as a fog volume (default) or as the density's iso-surface",
+    )
+    p.add_argument(
+        "--iso-value",
+        type=float,
+        help="density of the --bulk surface (default 0.5, the preview's render.iso_value)",
+    )
+    p.add_argument(
+        "--adaptivity", type=float, default=0.0, help="--bulk surface simplification in [0, 1] (0)"
+    )
+    p.add_argument(
+        "--surface-color",
+        metavar="R,G,B",
+        help="--bulk surface base colour, linear RGB in [0, 1] (default sand)",
+    )
+    p.add_argument("--hide-volume", action="store_true", help="load the bulk, hidden in renders")
     p.add_argument("--no-volume", action="store_true", help="do not load the density volume")
     p.add_argument("--no-lights", action="store_true", help="no sun and world")
     p.add_argument("--summary", metavar="OUT.json", help="write what was loaded as JSON")
@@ -743,6 +976,14 @@ def _parse_args(argv):
 
 def main(argv):
     args = _parse_args(argv)
+    color = None
+    if args.surface_color:
+        try:
+            color = tuple(float(v) for v in args.surface_color.split(","))
+        except ValueError:
+            color = ()
+        if len(color) != 3 or not all(0.0 <= c <= 1.0 for c in color):
+            raise ShellmpmError(f"--surface-color {args.surface_color}: expected R,G,B in [0, 1]")
     bpy.ops.wm.read_factory_settings(use_empty=True)
     context = bpy.context
     imported = import_run(
@@ -751,6 +992,10 @@ def main(argv):
         load_volume=not args.no_volume,
         hide_volume=args.hide_volume,
         add_lights=not args.no_lights,
+        bulk=args.bulk,
+        iso_value=args.iso_value,
+        adaptivity=args.adaptivity,
+        surface_color=color,
     )
     scene = context.scene
     if args.size:
