@@ -43,11 +43,13 @@ inline bool parse_options(int argc, char** argv, const std::vector<Option>& opti
   return true;
 }
 
-/// Options of the sheet benchmarks: --vertices N --steps S --threads 1,2.
+/// Options of the sheet benchmarks: --vertices N --steps S --threads 1,2
+/// --contact-at surface|stencil.
 struct SheetArgs {
   double vertices = 100000;
   int steps = 20;
   std::vector<int> threads = {1, 2};
+  std::string contact_at = "surface";  ///< shot.contact_at
   /// Quads per side of a square sheet with about `vertices` vertices.
   int quads_per_side() const { return static_cast<int>(std::round(std::sqrt(vertices))) - 1; }
 };
@@ -62,6 +64,9 @@ inline bool parse_sheet_args(int argc, char** argv, SheetArgs& a) {
       a.steps = std::atoi(argv[i + 1]);
     else if (k == "--threads")
       a.threads = parse_int_list(argv[i + 1]);
+    else if (k == "--contact-at" &&
+             (std::string(argv[i + 1]) == "surface" || std::string(argv[i + 1]) == "stencil"))
+      a.contact_at = argv[i + 1];
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return false;

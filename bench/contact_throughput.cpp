@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   s.shot.fps = 24;
   s.shot.domain_min = Vec3d(-1.3, -0.2, -1.3);
   s.shot.domain_max = Vec3d(1.3, 1.5, 1.3);
+  s.shot.contact_at = args.contact_at == "stencil" ? ContactAt::Stencil : ContactAt::Surface;
   ShellMaterialDesc m;
   m.name = "cotton";
   m.youngs_modulus = 5e5;
@@ -60,8 +61,9 @@ int main(int argc, char** argv) {
   s.colliders.push_back(ball);
   std::printf(
       "contact_throughput: cloth %dx%d quads (%d control points, %d contact particles), "
-      "dx = %.4g m, %s\n",
-      n, n, (n + 1) * (n + 1), 2 * n * n, h, sizeof(Real) == 4 ? "float" : "double");
+      "dx = %.4g m, %s, contact at the %ss\n",
+      n, n, (n + 1) * (n + 1), 2 * n * n, h, sizeof(Real) == 4 ? "float" : "double",
+      args.contact_at.c_str());
   double base = 0;
   for (int t : args.threads) {
     ThreadLimit limit(t);

@@ -4,18 +4,21 @@
 # contact_throughput, ...) so that both see the same machine state. It builds nothing.
 #
 #   bench/point_cost.sh [--build DIR] [--rounds N] [--threads "1 2"] [--steps S]
+#                       [--contact-at surface|stencil]
 #
 # DIR: the build folder holding bench/contact_throughput and bench/mpm_throughput
 # (default build). S: contact_throughput's timed steps (default 100: the shell guard's
 # list rebuilds, every few dozen steps there, must fall in the window). Per round and
 # thread count it prints the contact benchmark's ms per step, its cost per point (ms per
 # step over its control points and contact particles), the bulk particle-step and their
-# ratio; then the ratio's range over the rounds.
+# ratio; then the ratio's range over the rounds. --contact-at: the contact benchmark's
+# shot.contact_at (default surface, the scenes' default).
 set -eu
 build=build
 rounds=3
 threads="1 2"
 steps=100
+contact_at=surface
 while [ $# -gt 0 ]; do
   [ $# -ge 2 ] || { echo "point_cost.sh: $1 needs a value" >&2; exit 2; }
   case "$1" in
@@ -23,6 +26,7 @@ while [ $# -gt 0 ]; do
     --rounds) rounds=$2 ;;
     --threads) threads=$2 ;;
     --steps) steps=$2 ;;
+    --contact-at) contact_at=$2 ;;
     *) echo "point_cost.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift 2
@@ -34,12 +38,13 @@ for b in "$contact" "$bulk"; do
 done
 case "$rounds" in ''|*[!0-9]*|0) echo "point_cost.sh: --rounds must be a positive integer" >&2; exit 2 ;; esac
 case "$steps" in ''|*[!0-9]*|0) echo "point_cost.sh: --steps must be a positive integer" >&2; exit 2 ;; esac
+case "$contact_at" in surface|stencil) ;; *) echo "point_cost.sh: --contact-at must be surface or stencil" >&2; exit 2 ;; esac
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 r=1
 while [ "$r" -le "$rounds" ]; do
   for t in $threads; do
-    "$contact" --threads "$t" --steps "$steps" > "$tmp/c" 2>&1 ||
+    "$contact" --threads "$t" --steps "$steps" --contact-at "$contact_at" > "$tmp/c" 2>&1 ||
       { echo "point_cost.sh: $contact failed:" >&2; cat "$tmp/c" >&2; exit 1; }
     "$bulk" --threads "$t" > "$tmp/b" 2>&1 ||
       { echo "point_cost.sh: $bulk failed:" >&2; cat "$tmp/b" >&2; exit 1; }

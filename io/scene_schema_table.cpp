@@ -106,7 +106,7 @@ std::vector<KeySpec> build_schema() {
           .rule("see docs/accuracy.md#quality-presets"),
       Spec("shot.shell_velocities", T::Enum).to(&ShotSettings::shell_velocities).def("per_shell"),
       Spec("shot.fold_fields", T::Bool).to(&ShotSettings::fold_fields).def("true"),
-      Spec("shot.contact_at", T::Enum).to(&ShotSettings::contact_at).def("stencil"),
+      Spec("shot.contact_at", T::Enum).to(&ShotSettings::contact_at).def("surface"),
       Spec("shot.shell_guard", T::Bool).to(&ShotSettings::shell_guard).def("true"),
       Spec("shot.shell_guard_gap", T::Number)
           .to(&ShotSettings::shell_guard_gap)
@@ -114,7 +114,8 @@ std::vector<KeySpec> build_schema() {
           .unit("m")
           .ge(0)
           .le(1e3)
-          .rule("0: half the thinnest contact layer (contact_at surface), else the larger of 0.05 "
+          .rule("0: four fifths of the thinnest contact layer (contact_at surface), else the "
+                "larger of 0.05 "
                 "dx and the thickest"),
       Spec("shot.integrator", T::Enum)
           .to(&ShotSettings::integrator)

@@ -31,6 +31,7 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     j["contact_particles"] = s.contact_particles;
     j["contact_compressed"] = s.contact_compressed;
     j["contact_sliding"] = s.contact_sliding;
+    j["contact_nodes"] = s.contact_nodes;
     j["contact_energy"] = s.contact_energy;
     j["friction_work"] = s.friction_work;
     j["guard_pairs"] = s.guard_pairs;

@@ -30,6 +30,10 @@ namespace shellmpm {
 
 /// Fraction of dx within which a point engages its nodes' collider conditions.
 constexpr double kColliderReachCells = 0.1;
+/// Shell points with contact at the surfaces (given offsets) engage within this share of
+/// the reach past their contact surface: their look-ahead by the step's motion catches
+/// them before they pass it, and they rest within 0.02 dx of it.
+constexpr double kSurfaceReachShare = 0.2;
 
 class ColliderReach {
  public:

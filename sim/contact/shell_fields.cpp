@@ -342,7 +342,9 @@ Vec3 ShellFields::contact_normal(const Body& A, const Body& B, Real sign) {
 }
 
 Real ShellFields::shell_gap(const Body& A, const Body& B, Real h) const {
-  if (!surfaces_) return -std::numeric_limits<Real>::infinity();
+  // Two layers of one shell (its fold classes) meet at the stencils in either mode: its
+  // contact particles hold them (self-contact is not gated by the gap).
+  if (!surfaces_ || A.shell == B.shell) return -std::numeric_limits<Real>::infinity();
   return h * dx_ - (half_thickness_[A.shell] + half_thickness_[B.shell]);
 }
 
@@ -365,8 +367,11 @@ bool ShellFields::shell_pairs(std::vector<Body>& bodies) const {
         // sheets were pressed closest (hanging curtains hit at 20 m/s crossed).
         const Vec3 u = contact_normal(A, B, Real(1));
         h = u.dot(B.off - A.off);
-        if (std::abs(h) < Real(0.05)) {
-          if (!surfaces_) continue;
+        // Level: within 0.05 cells, or with surface contact (where sheets rest a thickness
+        // apart, often below 0.05 cells) within 0.001 cells, float round-off.
+        const bool gated = surfaces_ && A.shell != B.shell;
+        if (std::abs(h) < (gated ? Real(0.001) : Real(0.05))) {
+          if (!gated) continue;
           // Level within round-off: touching at any contact thickness; no normal to
           // choose, so the rule waits for the next step.
           acted = true;
@@ -441,11 +446,16 @@ void ShellFields::resolve_node(const GridNode& cn, std::size_t g, int n, bool mo
   for (Body& B : bodies) body_geometry(B);
   // Shell against shell (facing across the node, or stacked on one side of it),
   // then each shell against the bulk field: Bardenhagen's rule.
-  shell_pairs(bodies);
-  if (bulk) bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk);
+  bool met = shell_pairs(bodies);
+  if (bulk) met |= bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk);
   for (const Body& B : bodies) *B.r = B.vel - v0;
+  if (met) met_[g] |= std::uint64_t(1) << n;
   if (bulk) r_bulk_[g][n] = vk - v0;
   shared_[g] |= std::uint64_t(1) << n;
+  // Another body than the shell's own layers: another shell, or the bulk field.
+  bool others = bulk;
+  for (std::size_t i = 1; i < cnt && !others; ++i) others = bodies[i].shell != bodies[0].shell;
+  if (others) others_[g] |= std::uint64_t(1) << n;
   if (bulk) bulk_at_[g] |= std::uint64_t(1) << n;
 }
 
@@ -461,7 +471,9 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   find_field_blocks(combined, serial);
   r_bulk_.resize(ng);
   shared_.assign(ng, 0);
+  others_.assign(ng, 0);
   bulk_at_.assign(ng, 0);
+  met_.assign(ng, 0);
   dt_ = dt;
   dx_ = static_cast<Real>(combined.dx());
   const bool moments = bulk_particles && bulk_particles->size() > 0;
@@ -482,6 +494,13 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
       serial);
 }
 
+std::size_t ShellFields::met_nodes() const {
+  if (!active_) return 0;
+  std::size_t n = 0;
+  for (std::uint64_t bits : met_) n += static_cast<std::size_t>(__builtin_popcountll(bits));
+  return n;
+}
+
 void ShellFields::apart_sites(const SparseGrid& combined, const ShellPointTable& table,
                               const std::vector<Vec3>& points,
                               std::vector<std::vector<std::uint8_t>>& release, bool serial) const {
@@ -492,7 +511,7 @@ void ShellFields::apart_sites(const SparseGrid& combined, const ShellPointTable&
         const auto& nbr = combined.pblock_nbr[b];
         // Nothing shared around this block: its sites keep their state.
         if (std::none_of(nbr.begin(), nbr.end(),
-                         [&](int g) { return g >= 0 && shared_[std::size_t(g)] != 0; }))
+                         [&](int g) { return g >= 0 && others_[std::size_t(g)] != 0; }))
           return;
         const Vec3i bc = unpack_block(combined.pblock_key[b]) * kBlockSize;
         combined.for_each_point(b, [&](std::uint32_t i) {
@@ -500,12 +519,15 @@ void ShellFields::apart_sites(const SparseGrid& combined, const ShellPointTable&
           const QuadraticWeights W(combined.grid_coord(points[i]));
           const std::size_t s = table.shell(i);
           // Apart from the grid's own rule: some node of the stencil is shared with another
-          // body (or the shell's other fold class).
+          // body (another shell, or bulk material). Not with the shell's own other fold
+          // class: its contact particles hold its layers apart, as at the stencils (the
+          // heights split a fold into classes only a cell apart; released, a fold sank
+          // onto its cloth, shared its velocity and slid at a ninth of Coulomb's rate).
           bool apart = false;
           for_each_stencil_node(W, bc, [&](const StencilNode& n) {
             const int g = nbr[(n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2)];
             if (apart || g < 0) return;
-            apart = shared_[std::size_t(g)] >> block_node(n.px & 3, n.py & 3, n.pz & 3) & 1;
+            apart = others_[std::size_t(g)] >> block_node(n.px & 3, n.py & 3, n.pz & 3) & 1;
           });
           if (apart) release[s][table.local(i)] = 1;
         });

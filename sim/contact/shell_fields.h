@@ -81,6 +81,9 @@ class ShellFields {
                    const std::vector<Vec3>& points, std::vector<std::vector<std::uint8_t>>& release,
                    bool serial) const;
   bool contact_at_surfaces() const { return active_ && surfaces_; }
+  /// Grid nodes where the last p2g's rule found two bodies in contact (closing on each
+  /// other, or within the contact distance): stats.json's contact_nodes.
+  std::size_t met_nodes() const;
 
   /// Before the combined P2G: where one shell alone has fields (its folds' heights only),
   /// its control-point normals and the heights for shell_p2g_block to sum; else null.
@@ -334,6 +337,10 @@ class ShellFields {
   std::vector<std::array<Moment, kBlockNodes>> bulk_mom_;  ///< per combined grid block
   std::vector<std::uint64_t> shared_;
   std::vector<std::uint64_t> bulk_at_;  ///< per combined grid block: the bulk field is there
+  /// Per combined grid block: a bit per node shared with another body (another shell or
+  /// the bulk field, not only the shell's own fold classes): apart_sites.
+  std::vector<std::uint64_t> others_;
+  std::vector<std::uint64_t> met_;  ///< per combined grid block: the rule acted at the node
   /// Shared nodes' velocities before the colliders' conditions (keep_free_velocities), per
   /// combined grid block with shared nodes: free_[free_slot_[g]].
   std::vector<int> free_slot_;

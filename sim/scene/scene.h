@@ -57,9 +57,9 @@ struct ShotSettings {
   /// (sim/contact/shell_folds.cpp), so a fold slides over its own cloth at Coulomb's law;
   /// false: one (the fold drags; cheaper for a lone shell).
   bool fold_fields = true;
-  /// Where grid contact acts (ContactAt): the paper's cushion (the default while surface
-  /// contact is completed), or at the bodies' surfaces.
-  ContactAt contact_at = ContactAt::Stencil;
+  /// Where grid contact acts (ContactAt): at the bodies' surfaces (the default), or the
+  /// paper's cushion at the stencils.
+  ContactAt contact_at = ContactAt::Surface;
   /// The shell guard (sim/contact/shell_guard.h): stops contact shells from closing
   /// closer than shell_guard_gap where the grid cannot hold them apart.
   bool shell_guard = true;

@@ -51,6 +51,7 @@ struct FrameStats {
   std::size_t contact_particles = 0;   ///< contact particles of all shells
   std::size_t contact_compressed = 0;  ///< in contact (s3 < 1) after the frame's last step
   std::size_t contact_sliding = 0;     ///< sliding in the frame's last step
+  std::size_t contact_nodes = 0;       ///< grid nodes where bodies met in the frame's last step
   double contact_energy = 0;           ///< sum V psi [J]
   double friction_work = 0;            ///< dissipated by sliding friction since the start [J]
   // The shell guard (sim/contact/shell_guard.h) over the frame's steps.

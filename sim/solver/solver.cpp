@@ -352,6 +352,7 @@ void Solver::measure(FrameStats& s) const {
   }
   s.contact_compressed = c_.contact_step.compressed;
   s.contact_sliding = c_.contact_step.sliding;
+  s.contact_nodes = c_.shell_fields.met_nodes();
   s.friction_work = c_.friction_work;
   s.guard_pairs = c_.guard_frame.pairs;
   s.guard_impulses = c_.guard_frame.impulses;

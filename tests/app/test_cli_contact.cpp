@@ -13,9 +13,14 @@ TEST_CASE("CLI: check reports contact and warns when the mesh spacing is far fro
   INFO(ok.output);
   CHECK(ok.code == 0);
   CHECK(ok.output.find("contact: 3200 contact particles") != std::string::npos);
-  // dx 0.025, cloth 1 mm: the guard's gap is 0.05 dx.
-  CHECK(ok.output.find("shell guard: gap 0.00125 m") != std::string::npos);
+  // Cloth 1 mm, contact at the surfaces: the guard's gap is four fifths of the contact layer.
+  CHECK(ok.output.find("shell guard: gap 0.0008 m (four fifths of the thinnest contact layer") !=
+        std::string::npos);
   CHECK(ok.output.find("warning") == std::string::npos);
+  // At the stencils, dx 0.025: 0.05 dx.
+  const CmdResult stencil = run_shellmpm("check " + scene + " --set shot.contact_at=stencil");
+  INFO(stencil.output);
+  CHECK(stencil.output.find("shell guard: gap 0.00125 m (0.05 dx") != std::string::npos);
   const CmdResult fine = run_shellmpm("check " + scene + " --set shot.dx=0.01");
   INFO(fine.output);
   CHECK(fine.code == 0);

@@ -137,9 +137,15 @@ TEST_CASE("a user's contact thickness is the distance the stack keeps",
   }
 }
 
-TEST_CASE("a cloth dropped on a sphere rests on it at half its thickness",
-          "[contact][rest_gap][.][target]") {
-  const double dx = 0.025, R = 0.1;
+namespace {
+
+/// A felt cloth (mesh spacing dx) dropped on a 10 cm sphere collider, settled for half a
+/// 0.8 s: the gap [cells] between its lower contact surface and the sphere, the median
+/// over its limit vertices within 4 cm of the axis of their distance from the centre
+/// (their height alone reads the cap's curvature as a gap: 8 mm lower at 4 cm from the pole). The
+/// integrity monitor's median counts the cloth hanging past the sphere too: reported, not judged.
+double cloth_on_sphere(double dx) {
+  const double R = 0.1;
   Scene s = base_scene(dx);
   ColliderDesc ball;
   ball.name = "ball";
@@ -149,14 +155,36 @@ TEST_CASE("a cloth dropped on a sphere rests on it at half its thickness",
   ball.friction = 0.5;
   s.colliders.push_back(ball);
   s.shell_materials.push_back(felt());
-  s.shells.push_back(sheet("cloth", 0.4, 16, Vec3d(0, R + 0.03, 0)));
+  s.shells.push_back(
+      sheet("cloth", 0.4, static_cast<int>(std::lround(0.4 / dx)), Vec3d(0, R + 0.03, 0)));
   Solver solver(s);
-  for (int f = 2; f <= 12; ++f) solver.advance_to((f - 1) / s.shot.fps);
-  // The cloth's top, over the sphere's pole.
-  const double y = centre_height(*solver.shells()[0], 0.03);
-  const double gap = (y - 0.5 * felt().thickness - R) / dx;
-  INFO("cloth over the pole at y = " << y << ": gap " << gap << " dx");
-  CHECK(std::abs(gap) <= 0.1);
+  FrameStats fs;
+  for (int f = 2; f <= 20; ++f) fs = solver.advance_to((f - 1) / s.shot.fps);
+  CHECK_FALSE(fs.integrity.failed());
+  std::vector<Vec3> pos, nrm;
+  solver.shells()[0]->output_mesh(pos, nrm);
+  std::vector<double> r;
+  for (const Vec3& p : pos)
+    if (std::hypot(double(p.x()), double(p.z())) < 0.04) r.push_back(p.cast<double>().norm());
+  REQUIRE(r.size() > 8);
+  std::nth_element(r.begin(), r.begin() + std::ptrdiff_t(r.size() / 2), r.end());
+  const double gap = (r[r.size() / 2] - 0.5 * felt().thickness - R) / dx;
+  UNSCOPED_INFO("dx " << dx << ": cloth over the cap at " << r[r.size() / 2]
+                      << " m from the centre: gap " << gap
+                      << " dx; the monitor's median shell-collider "
+                      << "gap " << fs.integrity.shell_collider.median / dx << " dx");
+  return gap;
+}
+
+}  // namespace
+
+TEST_CASE("a cloth dropped on a sphere rests on it at half its thickness", "[contact][rest_gap]") {
+  CHECK(std::abs(cloth_on_sphere(0.025)) <= 0.1);
+}
+
+TEST_CASE("at half the cell size a cloth rests on a sphere at half its thickness",
+          "[contact][rest_gap][slow]") {
+  CHECK(std::abs(cloth_on_sphere(0.0125)) <= 0.1);
 }
 
 namespace {

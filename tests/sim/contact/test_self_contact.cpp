@@ -19,10 +19,19 @@ constexpr int kBasePoints = (kBaseCells + 1) * (kBaseCells + 1);
 // One shell of two parts on a slope of th_deg: a pinned 0.8 m cloth and a free 0.16 m
 // piece of it gap0 above, wound the same way (a stacked layer, as in a rolled sheet) or
 // the other way (a layer folded over, its normal facing the cloth).
+// How far above the cloth the free piece starts [m]: low enough that it lands and settles
+// before the fit starts at 0.1 s, above where contact holds it (some two cells with contact
+// at the stencils, a thickness at the surfaces).
+double drop_gap(ContactAt at) {
+  return at == ContactAt::Surface ? 0.03 : 0.07;
+}
+
 Scene fold_on_slope(double th_deg, double mu, bool folded, bool fold_fields = true,
-                    double gap0 = 0.07) {
+                    double gap0 = -1, ContactAt at = ShotSettings{}.contact_at) {
   Scene s = test::contact_test_scene(0.02);
   s.shot.fold_fields = fold_fields;
+  s.shot.contact_at = at;
+  if (gap0 < 0) gap0 = drop_gap(at);
   ShellMaterialDesc m = test::cloth_material();
   m.friction = mu;
   s.shell_materials.push_back(m);
@@ -57,8 +66,9 @@ struct Slide {
   double a_ref;      ///< Coulomb: g (sin - c_F cos) (negative: it should stick)
 };
 
-Slide run_fold(double th_deg, double mu, bool folded, bool fold_fields = true) {
-  const Scene s = fold_on_slope(th_deg, mu, folded, fold_fields);
+Slide run_fold(double th_deg, double mu, bool folded, bool fold_fields = true,
+               ContactAt at = ShotSettings{}.contact_at) {
+  const Scene s = fold_on_slope(th_deg, mu, folded, fold_fields, -1, at);
   Solver solver(s);
   REQUIRE(solver.shell_on_grid(0));
   const double th = th_deg * M_PI / 180;
@@ -105,6 +115,19 @@ TEST_CASE("a fold of one cloth sticks below the friction angle and slides freely
   const Slide free = run_fold(30, 0.0, true);
   INFO("30 deg, c_F 0: acceleration " << free.a << " m/s^2, g sin " << g_sin);
   CHECK(free.a == Approx(g_sin).epsilon(0.05));
+}
+
+TEST_CASE("a fold slides over its own cloth at Coulomb's law with contact at either place",
+          "[contact][slow]") {
+  // The default suite's fold test runs with the default contact mode; this one with both.
+  for (ContactAt at : {ContactAt::Surface, ContactAt::Stencil})
+    for (bool folded : {false, true}) {
+      const Slide r = run_fold(30, 0.3, folded, true, at);
+      INFO((at == ContactAt::Surface ? "surfaces, " : "stencils, ")
+           << (folded ? "folded over" : "stacked") << ": acceleration " << r.a << " m/s^2, Coulomb "
+           << r.a_ref << ", travelled " << r.travelled << " m");
+      CHECK(r.a == Approx(r.a_ref).epsilon(0.05));
+    }
 }
 
 TEST_CASE("one folding shell alone (mass and heights only off its folds) moves as with full fields",
