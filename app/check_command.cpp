@@ -210,7 +210,7 @@ int check_command(const CommonArgs& a) {
     std::printf("shell guard: gap %g m (%s)\n", ShellGuardStage::gap(scene),
                 scene.shot.shell_guard_gap > 0 ? "shot.shell_guard_gap"
                 : scene.shot.contact_at == ContactAt::Surface
-                    ? "four fifths of the thinnest contact layer, below the contact distance"
+                    ? "the thinnest contact layer less a fifth of it or 0.05 dx"
                     : "0.05 dx or the thickest contact shell");
   print_shells(solver);
   print_time(solver, mem);

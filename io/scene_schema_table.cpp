@@ -114,7 +114,8 @@ std::vector<KeySpec> build_schema() {
           .unit("m")
           .ge(0)
           .le(1e3)
-          .rule("0: four fifths of the thinnest contact layer (contact_at surface), else the "
+          .rule("0: the thinnest contact layer less a fifth of it or 0.05 dx (contact_at surface), "
+                "else the "
                 "larger of 0.05 "
                 "dx and the thickest"),
       Spec("shot.integrator", T::Enum)

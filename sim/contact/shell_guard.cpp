@@ -129,8 +129,10 @@ void item_lists(std::size_t n, std::size_t stamps, bool serial, const Visit& vis
 
 void ShellGuard::setup(const std::vector<GridShell>& shells, double gap, bool serial) {
   gap_ = gap;
+  bulk_gap_ = gap;
   serial_ = serial;
   meshes_.clear();
+  friction_.clear();
   point_offset_.assign(1, 0);
   vertex_offset_.assign(1, 0);
   for (const GridShell& g : shells) {
@@ -151,6 +153,8 @@ void ShellGuard::setup(const std::vector<GridShell>& shells, double gap, bool se
     point_offset_.push_back(point_offset_.back() + sh.size());
     vertex_offset_.push_back(vertex_offset_.back() + m.limit->num_vertices());
     meshes_.push_back(std::move(m));
+    friction_.push_back(g.contact ? static_cast<double>(g.contact->params().friction)
+                                  : sh.material().friction);
   }
   vert_shell_.clear();
   for (std::size_t s = 0; s < meshes_.size(); ++s) vert_shell_.resize(vertex_offset_[s + 1], s);
@@ -180,8 +184,9 @@ void ShellGuard::add_vertex(std::size_t s, int v, double scale) {
         {point_offset_[s] + static_cast<std::size_t>(pts[k]), scale * static_cast<double>(w[k])});
 }
 
-void ShellGuard::add_pair(const Vec3d& n, double d, double dt) {
+void ShellGuard::add_pair(const Vec3d& n, double d, double gap, double dt, double mu) {
   Pair p;
+  p.mu = mu;
   p.begin = pairs_.empty() ? 0 : pairs_.back().end;
   // Merge the entries of one control point (sorted by point, so the sums have a fixed
   // order).
@@ -197,7 +202,7 @@ void ShellGuard::add_pair(const Vec3d& n, double d, double dt) {
   entries_.resize(out);
   p.end = out;
   p.n = n;
-  p.target = -std::max(d - gap_, 0.0) / dt;
+  p.target = -std::max(d - gap, 0.0) / dt;
   p.denom = 0;
   for (std::size_t i = p.begin; i < p.end; ++i) {
     const Vec3d& im = inv_mass_[entries_[i].point];
@@ -593,7 +598,7 @@ void ShellGuard::gather_pairs(double r, double r_bulk, double dt) {
     if (!point_triangle_pair(pos_[p], T, r, tiny, w, d, n)) continue;
     add_vertex(vert_shell_[p], local(p), 1.0);
     for (int k = 0; k < 3; ++k) add_vertex(vert_shell_[T[k]], local(T[k]), -w[k]);
-    add_pair(n, d, dt);
+    add_pair(n, d, gap_, dt, std::sqrt(friction_[vert_shell_[p]] * friction_[vert_shell_[T[0]]]));
   }
   // Edge-edge pairs.
   for (const Eigen::Vector2i& c : ee_cand_) {
@@ -618,7 +623,7 @@ void ShellGuard::gather_pairs(double r, double r_bulk, double dt) {
     add_vertex(s, local(E[1]), st2[0]);
     add_vertex(s2, local(F[0]), -(1.0 - st2[1]));
     add_vertex(s2, local(F[1]), -st2[1]);
-    add_pair(n, d, dt);
+    add_pair(n, d, gap_, dt, std::sqrt(friction_[s] * friction_[s2]));
   }
   // Bulk particle-triangle pairs.
   for (const Eigen::Vector2i& c : bt_cand_) {
@@ -629,7 +634,7 @@ void ShellGuard::gather_pairs(double r, double r_bulk, double dt) {
     if (!point_triangle_pair(bulk_x0_[k], T, r_bulk, tiny, w, d, n)) continue;
     entries_.push_back({np + k, 1.0});
     for (int q = 0; q < 3; ++q) add_vertex(vert_shell_[T[q]], local(T[q]), -w[q]);
-    add_pair(n, d, dt);
+    add_pair(n, d, bulk_gap_, dt, friction_[vert_shell_[T[0]]]);
   }
 }
 
@@ -653,6 +658,30 @@ int ShellGuard::solve_pairs(double tol) {
     if (change <= tol) break;
   }
   return sweeps;
+}
+
+void ShellGuard::apply_friction() {
+  for (const Pair& p : pairs_) {
+    if (!(p.lambda > 0) || !(p.mu > 0)) continue;
+    Vec3d rel = Vec3d::Zero();
+    for (std::size_t i = p.begin; i < p.end; ++i) rel += entries_[i].w * v_[entries_[i].point];
+    const Vec3d vt = rel - p.n.dot(rel) * p.n;
+    const double s = vt.norm();
+    if (!(s > 0)) continue;
+    const Vec3d t = vt / s;
+    double denom = 0;
+    for (std::size_t i = p.begin; i < p.end; ++i) {
+      const Entry& en = entries_[i];
+      denom += en.w * en.w * t.dot(t.cwiseProduct(inv_mass_[en.point]));
+    }
+    if (!(denom > 0)) continue;
+    // The impulse that stops the sliding, capped at c_F times the normal one.
+    const double j = std::min(s / denom, p.mu * p.lambda);
+    for (std::size_t i = p.begin; i < p.end; ++i) {
+      const Entry& en = entries_[i];
+      v_[en.point] -= (en.w * j) * t.cwiseProduct(inv_mass_[en.point]);
+    }
+  }
 }
 
 void ShellGuard::write_back(std::vector<GridShell>& shells, ParticleSet* ps, double dt) const {
@@ -700,7 +729,7 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   if (!std::isfinite(vmax) || !std::isfinite(vbulk)) return st;  // diverged: the solver says so
   // Relative motion bounds this step: shell against shell, bulk against shell.
   const double reach = 2.0 * vmax * dt, reach_bulk = dt * (vmax + vbulk);
-  const double r = gap_ + reach, r_bulk = gap_ + reach_bulk;
+  const double r = gap_ + reach, r_bulk = bulk_gap_ + reach_bulk;
   // Candidate lists, rebuilt when the motion since the last build could bring a pair
   // left out within reach (a pair left out was at least gap + margin apart then), and
   // the bulk list also when the particles were reordered or added.
@@ -720,8 +749,8 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
     x_built_ = x0_;
   }
   if (bulk_rebuild) {
-    bulk_list_.start(gap_, reach_bulk);
-    build_bulk_candidates(gap_ + bulk_list_.margin, bulk, dt);
+    bulk_list_.start(bulk_gap_, reach_bulk);
+    build_bulk_candidates(bulk_gap_ + bulk_list_.margin, bulk, dt);
     built_epoch_ = bulk.epoch;
     built_count_ = nb;
   }
@@ -733,6 +762,12 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   // Projected Gauss-Seidel on the accumulated impulses (lambda >= 0).
   const double tol = 1e-4 * gap_ / dt;
   st.sweeps = solve_pairs(tol);
+  if (friction_on_) {
+    // Friction from the normal impulses, then the normal constraints again (friction
+    // changes velocities other pairs share).
+    apply_friction();
+    st.sweeps += solve_pairs(tol);
+  }
   for (const Pair& p : pairs_)
     if (p.lambda > 0) ++st.impulses;
   st.zoned = impact_zones(tol);

@@ -79,6 +79,16 @@ class ShellGuard {
   /// The shells' topology is fixed from here on. gap [m] > 0; serial: no threads.
   void setup(const std::vector<GridShell>& shells, double gap, bool serial = false);
   double gap() const { return gap_; }
+  /// Coulomb friction on the pairs the guard pushes apart (off by default): each pair's
+  /// tangential relative velocity loses at most c_F times its normal impulse, with c_F the
+  /// geometric mean of the two shells' (a shell's own against bulk material). With contact
+  /// at the surfaces the guard holds the last part of a thick contact layer (see
+  /// ShellGuardStage::gap), where it must not let the bodies slide freely.
+  void set_friction(bool on) { friction_on_ = on; }
+  /// The gap kept between bulk particles and shells [m] (setup: the gap): a particle's
+  /// centre rests half a particle spacing out from its material's surface, so with a
+  /// thick contact layer the shells' gap would keep bulk material too far out.
+  void set_bulk_gap(double gap) { bulk_gap_ = gap; }
   /// One pass after G2P and the colliders' projection (see the file comment): changes v
   /// and x of control points. start: each shell's control points at x^n.
   ShellGuardStats apply(std::vector<GridShell>& shells, const std::vector<std::vector<Vec3>>& start,
@@ -109,10 +119,13 @@ class ShellGuard {
     double target;           ///< lower bound on n . (u_1 - u_2) [m/s]
     double denom;            ///< J M^-1 J^T
     double lambda = 0;       ///< accumulated impulse [kg m/s]
+    double mu = 0;           ///< Coulomb coefficient (set_friction)
   };
   /// Limit vertex v of shell s as entries with weight scale.
   void add_vertex(std::size_t s, int v, double scale);
-  void add_pair(const Vec3d& n, double d, double dt);
+  void add_pair(const Vec3d& n, double d, double gap, double dt, double mu);
+  /// One Gauss-Seidel sweep of friction impulses over the pairs with a normal impulse.
+  void apply_friction();
   /// Point x against limit triangle T (at pos_): closer than r? Then the closest point's
   /// barycentric weights w, the distance d and the pair's unit normal n (from the
   /// triangle to x; the triangle's own normal when x is within `tiny` of it).
@@ -169,6 +182,9 @@ class ShellGuard {
   };
 
   double gap_ = 0;
+  double bulk_gap_ = 0;
+  bool friction_on_ = false;
+  std::vector<double> friction_;  ///< per shell: its contact's c_F
   bool serial_ = false;
   std::vector<Mesh> meshes_;
   std::vector<std::size_t> point_offset_;   ///< first control point of each shell

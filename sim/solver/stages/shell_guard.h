@@ -11,6 +11,9 @@ class ShellGuardStage final : public Stage {
   static bool needed(const Scene& s);
   /// The gap the scene asks for: shot.shell_guard_gap, or its default [m].
   static double gap(const Scene& s);
+  /// The gap kept between bulk particles and shells [m]: gap(s), or with contact at the
+  /// surfaces and no shot.shell_guard_gap at most half the thinnest contact layer.
+  static double bulk_gap(const Scene& s);
   std::string_view name() const override { return "shell_guard"; }
   void run(StepContext& c) override;
 
