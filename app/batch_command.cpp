@@ -16,8 +16,8 @@
 #include "farm/task_runner.h"
 #include "farm/wedge_table.h"
 #include "io/atomic_file.h"
-#include "io/available_memory.h"
 #include "io/user_error.h"
+#include "shot/available_memory.h"
 
 namespace shellmpm {
 namespace {

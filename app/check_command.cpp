@@ -2,15 +2,15 @@
 
 #include "app/commands.h"
 #include "app/scene_loading.h"
-#include "io/available_memory.h"
 #include "io/scene_quality.h"
-#include "io/study/preset_errors.h"
+#include "shot/available_memory.h"
 #include "sim/core/parallel.h"
 #include "sim/scene/scene_words.h"
 #include "sim/solver/shot_estimate.h"
 #include "sim/solver/solver.h"
 #include "sim/solver/stages/shell_guard.h"
 #include "sim/solver/step_limits.h"
+#include "study/preset_errors.h"
 
 namespace shellmpm {
 namespace {

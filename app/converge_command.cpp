@@ -1,14 +1,14 @@
 // `shellmpm converge SCENE --vary KEY=V1,V2,V3 --measure QUANTITY`: the user's shot at
 // several settings, the quantity per setting, its observed order, a Richardson estimate
-// and what each setting cost (io/study/convergence.h).
+// and what each setting cost (study/convergence.h).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 
 #include "app/commands.h"
 #include "io/atomic_file.h"
-#include "io/study/child_run.h"
-#include "io/study/convergence.h"
+#include "study/child_run.h"
+#include "study/convergence.h"
 
 namespace shellmpm {
 

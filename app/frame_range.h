@@ -2,7 +2,7 @@
 #pragma once
 #include <string>
 
-#include "io/shot_runner.h"  // kMaxFrameNumber
+#include "io/frame_number.h"  // kMaxFrameNumber
 
 namespace shellmpm {
 

@@ -9,10 +9,10 @@
 #include "app/scene_loading.h"
 #include "app/stop_signals.h"
 #include "io/atomic_file.h"
-#include "io/run_resolved.h"
-#include "io/shot_runner.h"
 #include "render/preview_job.h"
 #include "render/run_manifest.h"
+#include "shot/run_resolved.h"
+#include "shot/shot_runner.h"
 #include "sim/core/parallel.h"
 
 namespace shellmpm {
@@ -21,7 +21,7 @@ namespace {
 
 /// run.json, which lets `shellmpm render OUTDIR` find the scene later (when the output
 /// folder cannot be made, run_shot reports it), with a "resolved" block beside the
-/// manifest's fields for tools that do not read YAML (io/run_resolved.h; the Blender
+/// manifest's fields for tools that do not read YAML (shot/run_resolved.h; the Blender
 /// loader in tools/blender).
 void write_manifest(const RunArgs& a, const Scene& scene) {
   std::error_code ec;

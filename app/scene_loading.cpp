@@ -4,7 +4,6 @@
 #include <sstream>
 
 #include "app/frame_range.h"
-#include "io/available_memory.h"
 #include "io/checkpoint.h"
 #include "io/mesh_sdf.h"
 #include "io/output_folders.h"
@@ -12,6 +11,7 @@
 #include "io/scene_reader.h"
 #include "io/shell_assets.h"
 #include "io/user_error.h"
+#include "shot/available_memory.h"
 
 namespace shellmpm {
 

@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "app/commands.h"
-#include "io/run_memory.h"
+#include "shot/run_memory.h"
 #include "sim/scene/scene.h"
 
 namespace shellmpm {
@@ -21,11 +21,11 @@ struct LoadedScene {
 LoadedScene load_scene_for_cli(const CommonArgs& a, const std::string& frames,
                                const std::string& output);
 
-/// The memory estimate of running the loaded scene (io/run_memory.h).
+/// The memory estimate of running the loaded scene (shot/run_memory.h).
 RunMemory estimate_memory(const LoadedScene& ls);
 
 /// Before `run` builds anything: refuses (UserError, exit 2) a scene whose estimated peak
-/// exceeds the available memory (io/available_memory.h), unless `force`; then creates the
+/// exceeds the available memory (shot/available_memory.h), unless `force`; then creates the
 /// output folders (io/output_folders.h). `previews`: preview images will be written.
 void prepare_run(const LoadedScene& ls, bool force, bool previews);
 

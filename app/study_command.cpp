@@ -1,13 +1,13 @@
-// `shellmpm study`: runs the reference problems (io/study), writes results.json,
+// `shellmpm study`: runs the reference problems (study/), writes results.json,
 // results.csv, summary.md and the plots, and prints where they are.
 #include <cstdio>
 #include <filesystem>
 
 #include "app/commands.h"
-#include "io/study/child_run.h"
-#include "io/study/plots.h"
-#include "io/study/study_report.h"
-#include "io/study/study_runner.h"
+#include "study/child_run.h"
+#include "study/plots.h"
+#include "study/study_report.h"
+#include "study/study_runner.h"
 
 namespace shellmpm {
 

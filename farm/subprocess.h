@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "io/study/child_run.h"  // self_executable(): children run this same build
+#include "study/child_run.h"  // self_executable(): children run this same build
 
 namespace shellmpm {
 

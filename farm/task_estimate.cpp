@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "io/mesh_sdf.h"
-#include "io/run_memory.h"
+#include "shot/run_memory.h"
 #include "io/scene_bounds.h"
 #include "io/scene_reader.h"
 #include "io/shell_assets.h"

@@ -1,6 +1,6 @@
 // What a task will cost, before it runs (`batch plan`, and the Slurm engine's memory request
 // and signal margin): the scene read and checked as `shellmpm check` does it (with the
-// task's overrides), its peak memory (io/run_memory.h) and its time per frame
+// task's overrides), its peak memory (shot/run_memory.h) and its time per frame
 // (sim/solver/shot_estimate.h) on the threads it will get.
 #pragma once
 #include <string>

@@ -12,7 +12,7 @@
 
 #include "io/atomic_file.h"
 #include "io/checksum.h"
-#include "io/shot_runner.h"
+#include "io/frame_number.h"
 #include "sim/contact/friction_return_map.h"
 #include "sim/solver/solver.h"
 

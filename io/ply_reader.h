@@ -1,12 +1,15 @@
 // Reading back the binary PLY caches a run writes (particles.####.ply, shell meshes),
 // fast and strictly: anything but little-endian binary with float x, y, z is refused.
 #pragma once
+#include <Eigen/Core>
 #include <string>
 #include <vector>
 
-#include "render/preview_scene.h"
-
 namespace shellmpm {
+
+/// A float position or direction, as the caches store them (the same type as the preview
+/// renderer's Vec3f).
+using Vec3f = Eigen::Vector3f;
 
 struct PlyMesh {
   std::vector<Vec3f> positions;

@@ -8,7 +8,7 @@
 // the basis of every quadrature point, freed once the Kirchhoff-Love data is built), then
 // contact and the integrity monitor, then the particles of the fill sources; a step adds
 // the grid, per-shell grids and force buffers. Writers of the run (VDB, caches,
-// checkpoints) add their own transients: io/run_memory.h.
+// checkpoints) add their own transients: shot/run_memory.h.
 #pragma once
 #include <cstddef>
 #include <string>
