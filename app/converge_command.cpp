@@ -7,6 +7,7 @@
 
 #include "app/commands.h"
 #include "io/atomic_file.h"
+#include "farm/subprocess.h"
 #include "study/child_run.h"
 #include "study/convergence.h"
 

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "farm/subprocess.h"
 #include "study/child_run.h"
 #include "study/plots.h"
 #include "study/study_report.h"

@@ -7,9 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "study/child_run.h"  // self_executable(): children run this same build
-
 namespace shellmpm {
+
+/// The path of the running executable (/proc/self/exe): the farm's and the study's
+/// children run this same build.
+/// @throws std::runtime_error when /proc/self/exe cannot be read.
+std::string self_executable();
 
 /// The full path of `name` on PATH (or `name` itself when it holds a '/' and exists), or
 /// "" when there is none.

@@ -29,13 +29,6 @@ std::string tail_of(const std::string& path, std::size_t max_chars) {
 
 }  // namespace
 
-std::string self_executable() {
-  std::error_code ec;
-  const std::filesystem::path p = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (ec) throw std::runtime_error("cannot find the shellmpm executable: " + ec.message());
-  return p.string();
-}
-
 ChildRunResult run_child(const ChildRunRequest& r) {
   std::vector<std::string> args = {r.binary, "run",     r.scene,     "--output",
                                    r.output, "--quiet", "--threads", std::to_string(r.threads)};

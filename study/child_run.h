@@ -35,7 +35,4 @@ ChildRunResult run_child(const ChildRunRequest& r);
 /// @throws std::runtime_error when the process cannot be started.
 ChildRunResult run_process(const std::vector<std::string>& argv, const std::string& log);
 
-/// The path of the running executable (/proc/self/exe).
-std::string self_executable();
-
 }  // namespace shellmpm

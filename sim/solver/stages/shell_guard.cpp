@@ -13,6 +13,26 @@ namespace {
 /// closer (a thick layer).
 constexpr double kSurfaceGuardShare = 0.8;
 constexpr double kSurfaceGuardCells = 0.05;
+
+
+/// The thinnest and thickest contact layer among the shells in contact: infinity and 0
+/// where no shell has contact.
+struct ContactLayers {
+  double thinnest = std::numeric_limits<double>::infinity();
+  double thickest = 0;
+};
+
+ContactLayers contact_layers(const Scene& s) {
+  ContactLayers l;
+  for (std::size_t i = 0; i < s.shells.size(); ++i) {
+    if (!shell_has_contact(s, i)) continue;
+    const ShellMaterialDesc& m = s.shell_materials[static_cast<std::size_t>(s.shells[i].material)];
+    const double c = m.contact_thickness.value_or(m.thickness);
+    l.thinnest = std::min(l.thinnest, c);
+    l.thickest = std::max(l.thickest, c);
+  }
+  return l;
+}
 }  // namespace
 
 bool ShellGuardStage::needed(const Scene& s) {
@@ -21,27 +41,22 @@ bool ShellGuardStage::needed(const Scene& s) {
 
 double ShellGuardStage::gap(const Scene& s) {
   if (s.shot.shell_guard_gap > 0) return s.shot.shell_guard_gap;
-  const bool surface = s.shot.contact_at == ContactAt::Surface;
-  // Stencil contact: the larger of 0.05 dx and the thickest contact shell. Surface contact
-  // holds bodies at their contact thickness on the grid, so the guard, a backstop with
-  // Coulomb friction, stays just below it: c - min(0.2 c, 0.05 dx) for the thinnest
-  // contact layer c. At half of c a strip wrung by four turns
-  // (scenes/stress/strip_twist_4turns.yaml), whose layers only the guard holds where
-  // three meet in a stencil, crossed itself at frame 59. A layer of half a cell or more is
-  // held by the grid only in part (the upper sheet's stencil reaches nodes the lower one's
-  // does not, whose velocity the pair rule does not hold): the sheets sank 0.13 and 0.39
-  // dx below layers of 0.5 and 1 dx onto a guard at half of c. The guard, 0.05 dx under
-  // the layer and with friction, holds that last part.
-  double g = surface ? std::numeric_limits<double>::infinity() : 0.05 * s.shot.dx;
-  for (std::size_t i = 0; i < s.shells.size(); ++i) {
-    if (!shell_has_contact(s, i)) continue;
-    const ShellMaterialDesc& m = s.shell_materials[static_cast<std::size_t>(s.shells[i].material)];
-    const double c = m.contact_thickness.value_or(m.thickness);
-    g = surface ? std::min(
-                      g, c - std::min((1 - kSurfaceGuardShare) * c, kSurfaceGuardCells * s.shot.dx))
-                : std::max(g, c);
-  }
-  return std::isfinite(g) ? g : 0.05 * s.shot.dx;
+  const ContactLayers l = contact_layers(s);
+  const double dx = s.shot.dx;
+  // Stencil contact: the larger of 0.05 dx and the thickest contact shell.
+  if (s.shot.contact_at != ContactAt::Surface) return std::max(0.05 * dx, l.thickest);
+  // Surface contact holds bodies at their contact thickness on the grid, so the guard, a
+  // backstop with Coulomb friction, stays just below it: c - min(0.2 c, 0.05 dx) for the
+  // thinnest contact layer c (the formula grows with c). At half of c a strip wrung by
+  // four turns (scenes/stress/strip_twist_4turns.yaml), whose layers only the guard holds
+  // where three meet in a stencil, crossed itself at frame 59. A layer of half a cell or
+  // more is held by the grid only in part (the upper sheet's stencil reaches nodes the
+  // lower one's does not, whose velocity the pair rule does not hold): the sheets sank
+  // 0.13 and 0.39 dx below layers of 0.5 and 1 dx onto a guard at half of c. The guard,
+  // 0.05 dx under the layer and with friction, holds that last part.
+  if (!std::isfinite(l.thinnest)) return 0.05 * dx;
+  const double c = l.thinnest;
+  return c - std::min((1 - kSurfaceGuardShare) * c, kSurfaceGuardCells * dx);
 }
 
 double ShellGuardStage::bulk_gap(const Scene& s) {
@@ -49,13 +64,8 @@ double ShellGuardStage::bulk_gap(const Scene& s) {
   if (s.shot.shell_guard_gap > 0 || s.shot.contact_at != ContactAt::Surface) return g;
   // A bulk particle's centre rests half its contact layer plus half a particle spacing
   // out from a shell's limit surface: half the thinnest layer stays below that.
-  double h = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < s.shells.size(); ++i) {
-    if (!shell_has_contact(s, i)) continue;
-    const ShellMaterialDesc& m = s.shell_materials[static_cast<std::size_t>(s.shells[i].material)];
-    h = std::min(h, 0.5 * m.contact_thickness.value_or(m.thickness));
-  }
-  return std::isfinite(h) ? std::min(g, h) : g;
+  const ContactLayers l = contact_layers(s);
+  return std::isfinite(l.thinnest) ? std::min(g, 0.5 * l.thinnest) : g;
 }
 
 void ShellGuardStage::run(StepContext& c) {
