@@ -96,6 +96,9 @@ void print_shells(const Solver& solver) {
 /// dt_min (the run would stop).
 void print_time(const Solver& solver, const RunMemory& mem) {
   const ShotSettings& s = solver.scene().shot;
+  if (!s.integrator_reason.empty())
+    std::printf("integrator: auto chose %s: %s\n", word_of(s.integrator).c_str(),
+                s.integrator_reason.c_str());
   if (s.integrator == Integrator::Implicit) {
     // No wave-speed bound: the step follows motion, the frame and the Newton solves.
     char method[64] = "backward Euler";

@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "app/commands.h"
-#include "io/atomic_file.h"
 #include "farm/subprocess.h"
+#include "io/atomic_file.h"
 #include "study/child_run.h"
 #include "study/convergence.h"
 

@@ -14,6 +14,7 @@
 #include "shot/run_resolved.h"
 #include "shot/shot_runner.h"
 #include "sim/core/parallel.h"
+#include "sim/scene/scene_words.h"
 
 namespace shellmpm {
 
@@ -70,6 +71,9 @@ int run_command(const RunArgs& a) {
   Progress progress(a.verbosity, scene.shot.frame_start, scene.shot.frame_end);
   if (a.verbosity == Verbosity::Verbose)
     progress.message("threads: " + std::to_string(ThreadLimit::active()));
+  if (!scene.shot.integrator_reason.empty())
+    progress.message("integrator: auto chose " + word_of(scene.shot.integrator) + ": " +
+                     scene.shot.integrator_reason);
   write_manifest(a, scene);
   std::unique_ptr<PreviewJob> preview;
   if (a.preview || scene.render.preview) preview = make_preview(scene, progress);

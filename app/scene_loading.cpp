@@ -12,6 +12,7 @@
 #include "io/shell_assets.h"
 #include "io/user_error.h"
 #include "shot/available_memory.h"
+#include "sim/solver/integrator_choice.h"
 
 namespace shellmpm {
 
@@ -38,6 +39,7 @@ LoadedScene load_scene_for_cli(const CommonArgs& a, const std::string& frames,
   load_scene_assets(ls.scene);
   load_shell_meshes(ls.scene);
   check_scene_bounds(ls.scene);
+  resolve_integrator(ls.scene);
   ls.baseline = resident_bytes();
   return ls;
 }

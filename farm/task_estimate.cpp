@@ -4,11 +4,12 @@
 #include <cmath>
 
 #include "io/mesh_sdf.h"
-#include "shot/run_memory.h"
 #include "io/scene_bounds.h"
 #include "io/scene_reader.h"
 #include "io/shell_assets.h"
 #include "io/user_error.h"
+#include "shot/run_memory.h"
+#include "sim/solver/integrator_choice.h"
 #include "sim/solver/shot_estimate.h"
 #include "sim/solver/solver.h"
 
@@ -32,6 +33,7 @@ TaskEstimate estimate_task(const BatchTask& t, int threads, double baseline) {
     load_scene_assets(scene);
     load_shell_meshes(scene);
     check_scene_bounds(scene);
+    resolve_integrator(scene);
   } catch (const UserError& e) {
     rethrow_for_task(e, t);
   }

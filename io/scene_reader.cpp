@@ -83,7 +83,8 @@ void read_shot(const DocNode& node, ShotSettings& shot) {
   d.finish();
   // The implicit integrator's steps are bounded by motion and the frame, not by dt_max's
   // explicit default: unless given, dt_max is one frame there.
-  if (shot.integrator == Integrator::Implicit && !r.has("dt_max")) shot.dt_max = 1.0 / shot.fps;
+  shot.dt_max_set = r.has("dt_max");
+  if (shot.integrator == Integrator::Implicit && !shot.dt_max_set) shot.dt_max = 1.0 / shot.fps;
   check_shot_timing(r, shot);
   check_shot_domain(r, d, shot);
   r.finish();

@@ -67,7 +67,8 @@ std::vector<KeySpec> build_schema() {
           .def("1e-2")
           .unit("s")
           .gt(0)
-          .rule(">= dt_min; with shot.integrator implicit the default is one frame (1 / fps)"),
+          .rule(
+              ">= dt_min; with an implicit step (also auto's) the default is one frame (1 / fps)"),
       Spec("shot.gravity", T::Vec3)
           .to(&ShotSettings::gravity)
           .def("[0, -9.81, 0]")

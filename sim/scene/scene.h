@@ -32,8 +32,9 @@ enum class ContactAt { Surface, Stencil };
 /// Shot-wide settings.
 /// How a step advances: explicit (symplectic Euler, steps bounded by the fastest elastic
 /// wave) or implicit (backward Euler by Newton's method, sim/implicit/; steps bounded by
-/// motion, the frame and the Newton cap).
-enum class Integrator { Explicit, Implicit };
+/// motion, the frame and the Newton cap); auto: one of the two by the rule of
+/// sim/solver/integrator_choice.h, resolved when the scene is read (a Solver never sees it).
+enum class Integrator { Explicit, Implicit, Auto };
 /// The implicit shell step's CG preconditioner (sim/implicit/shell_step.h).
 enum class ImplicitPreconditioner { Factorised, BlockJacobi };
 
@@ -66,6 +67,11 @@ struct ShotSettings {
   double shell_guard_gap = 0;  ///< [m]; 0: ShellGuardStage::gap
   std::string units = "m";     ///< informational, written to VDB metadata
   Integrator integrator = Integrator::Explicit;
+  /// shot.dt_max was given (else an implicit step's default is one frame, also when auto
+  /// chooses implicit).
+  bool dt_max_set = false;
+  /// Why `auto` chose the integrator it did (resolve_integrator); empty otherwise.
+  std::string integrator_reason;
   /// Implicit: a Newton solve has converged when no velocity correction it asks for
   /// exceeds this [m/s].
   double implicit_tolerance = 1e-4;

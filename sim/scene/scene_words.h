@@ -31,8 +31,8 @@ struct EnumWords;
   }
 
 SHELLMPM_ENUM_WORDS(Transfer, 2, {"apic", Transfer::Apic}, {"mls", Transfer::Mls});
-SHELLMPM_ENUM_WORDS(Integrator, 2, {"explicit", Integrator::Explicit},
-                    {"implicit", Integrator::Implicit});
+SHELLMPM_ENUM_WORDS(Integrator, 3, {"explicit", Integrator::Explicit},
+                    {"implicit", Integrator::Implicit}, {"auto", Integrator::Auto});
 SHELLMPM_ENUM_WORDS(ImplicitPreconditioner, 2, {"factorised", ImplicitPreconditioner::Factorised},
                     {"block_jacobi", ImplicitPreconditioner::BlockJacobi});
 SHELLMPM_ENUM_WORDS(Quality, 4, {"draft", Quality::Draft}, {"preview", Quality::Preview},

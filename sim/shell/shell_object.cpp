@@ -281,19 +281,31 @@ double ShellObject::project_plasticity(bool serial) {
 }
 
 double ShellObject::stable_dt(double cfl) const {
-  const double E = mat_.youngs_modulus, nu = mat_.poisson_ratio, rho = mat_.density;
-  const double c = std::sqrt(E / (rho * (1 - nu * nu)));      // membrane wave speed
-  const double kappa = c * mat_.thickness / std::sqrt(12.0);  // bending: omega = kappa k^2
-  const double h = min_edge_;
+  return shell_stable_dt(mat_, min_edge_, cfl);
+}
+
+double shortest_edge(const ShellMesh& mesh) {
+  double h = std::numeric_limits<double>::infinity();
+  for (const auto& t : mesh.triangles)
+    for (int e = 0; e < 3; ++e)
+      h = std::min(h, (mesh.vertices[t[e]] - mesh.vertices[t[(e + 1) % 3]]).norm());
+  return h;
+}
+
+double shell_stable_dt(const ShellMaterialDesc& mat, double min_edge, double cfl) {
+  const double E = mat.youngs_modulus, nu = mat.poisson_ratio, rho = mat.density;
+  const double c = std::sqrt(E / (rho * (1 - nu * nu)));     // membrane wave speed
+  const double kappa = c * mat.thickness / std::sqrt(12.0);  // bending: omega = kappa k^2
+  const double h = min_edge;
   // Loop-basis shells with lumped masses are stable up to about 0.3 h / c (measured on
   // a cantilever; 0.5 h / c diverges), so the shot's CFL is capped at 0.5 and scaled.
   const double k = 0.6 * std::min(cfl, 0.5);
   double dt = k * h / c;
   dt = std::min(dt, k * h * h / (4.0 * kappa));
-  if (mat_.stiffness_damping > 0) {
+  if (mat.stiffness_damping > 0) {
     // Central difference with damping ratio xi = beta omega / 2 at the highest frequency
     // omega = 2 / dt is stable for dt <= (2 / omega)(sqrt(1 + xi^2) - xi).
-    const double xi = mat_.stiffness_damping / dt;
+    const double xi = mat.stiffness_damping / dt;
     dt *= std::sqrt(1 + xi * xi) - xi;
   }
   return dt;

@@ -21,6 +21,13 @@ namespace shellmpm {
 /// with scale, rotation and translation.
 ShellMesh build_shell_rest_mesh(const ShellDesc& desc);
 
+/// The largest stable explicit step of a shell of material m whose shortest control-mesh
+/// edge is min_edge [m], for its membrane and bending waves [s] (ShellObject::stable_dt).
+double shell_stable_dt(const ShellMaterialDesc& m, double min_edge, double cfl);
+
+/// The shortest edge of a mesh's triangles [m] (infinity without triangles).
+double shortest_edge(const ShellMesh& mesh);
+
 class ShellObject {
  public:
   ShellObject(const ShellDesc& desc, const ShellMaterialDesc& mat, ShellMesh rest);

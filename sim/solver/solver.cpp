@@ -9,6 +9,7 @@
 
 #include "sim/core/parallel.h"
 #include "sim/shell/preroll.h"
+#include "sim/solver/integrator_choice.h"
 #include "sim/solver/stages/registry.h"
 #include "sim/solver/stages/scene_rules.h"
 #include "sim/solver/step_limits.h"
@@ -16,6 +17,7 @@
 namespace shellmpm {
 Solver::Solver(const Scene& scene, SolverOptions opt) {
   c_.scene = scene;
+  resolve_integrator(c_.scene);  // a scene built in code; the CLI resolves auto on loading
   c_.opt = opt;
   const ShotSettings& s = c_.scene.shot;
   for (const MaterialDesc& m : c_.scene.materials) {
@@ -83,9 +85,8 @@ void Solver::setup_contact() {
     cp.friction = m.friction;
     c_.contacts[i] = std::make_unique<ShellContact>(c_.shells[i]->basis(), c_.shells[i]->rest,
                                                     m.thickness, m.contact_samples, cp);
-    // Contact wave speed: psi'' <= 2 k_c (at s3 = 0) and gamma, over the shell density.
-    const double c = std::sqrt(2.0 * std::max(cp.kc, cp.gamma) / m.density);
-    c_.shell_dt = std::min(c_.shell_dt, c_.scene.shot.cfl * c_.scene.shot.dx / c);
+    c_.shell_dt =
+        std::min(c_.shell_dt, shell_contact_stable_dt(m, c_.scene.shot.cfl, c_.scene.shot.dx));
     GridShell g;
     g.shell = c_.shells[i].get();
     g.contact = c_.contacts[i].get();

@@ -295,6 +295,13 @@ std::string describe_step_limits(const std::vector<StepLimit>& limits, double dt
     out += (i == 0 ? "limited by " : "; also ") + l.detail + " (" + fmt("%.2g", l.dt) +
            " s); to raise it: " + l.hint;
   }
+  const StepLimitKind k = limits.front().kind;
+  if (k == StepLimitKind::ShellElastic || k == StepLimitKind::ShellContact ||
+      k == StepLimitKind::Material) {
+    out +=
+        ". Or keep it as it is and set shot.integrator: auto (or implicit): implicit steps "
+        "follow the motion, not the stiffness (docs/implicit.md)";
+  }
   return out;
 }
 

@@ -51,7 +51,8 @@ std::vector<StepLimit> step_limits(const Solver& solver, bool upcoming = false);
 /// One sentence for a step that is too small: the first limit (its detail and dt) and
 /// every other limit whose dt is below dt_min, each with its hint; e.g. "limited by
 /// material 'steel': ... (1.0e-07 s); to raise it: a softer material ...". `limits` is
-/// sorted as step_limits returns it and not empty.
+/// sorted as step_limits returns it and not empty. When a stiffness (a shell's, its
+/// contact's or a material's) sets the step, it ends by naming the implicit integrator.
 std::string describe_step_limits(const std::vector<StepLimit>& limits, double dt_min);
 
 }  // namespace shellmpm

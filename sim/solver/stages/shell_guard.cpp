@@ -14,7 +14,6 @@ namespace {
 constexpr double kSurfaceGuardShare = 0.8;
 constexpr double kSurfaceGuardCells = 0.05;
 
-
 /// The thinnest and thickest contact layer among the shells in contact: infinity and 0
 /// where no shell has contact.
 struct ContactLayers {

@@ -131,6 +131,7 @@ TEST_CASE("step limits: one very short mesh edge is named with its vertices and 
     REQUIRE(has(msg, "shell 'film'"));
     REQUIRE(has(msg, "0.17 mm"));
     REQUIRE(has(msg, "merge the vertices"));
+    REQUIRE(has(msg, "shot.integrator: auto"));  // the way out that keeps the mesh
   }
 }
 
@@ -304,4 +305,9 @@ TEST_CASE("step limits: the description names every cause below dt_min", "[step_
   REQUIRE(has(d, "; also material 'steel': stiff (1e-07 s); to raise it: softer"));
   REQUIRE(!has(d, "dt_max"));
   REQUIRE(!has(describe_step_limits(limits, 5e-8), "steel"));
+  // A stiffness sets the step: the implicit integrator is named; a speed: it is not.
+  REQUIRE(has(d, "shot.integrator: auto"));
+  std::vector<StepLimit> fast = {
+      {StepLimitKind::ColliderSpeed, 1e-8, "collider 'bat': speed", "slower", false}};
+  REQUIRE(!has(describe_step_limits(fast, 1e-6), "integrator"));
 }
