@@ -8,6 +8,7 @@
 #include "sim/core/parallel.h"
 #include "sim/mpm/apic_stencil.h"
 #include "sim/mpm/bspline.h"
+#include "sim/shell/kl_stiffness.h"
 
 namespace shellmpm {
 namespace {
@@ -282,16 +283,6 @@ double GridShellTerms::gradient(const std::vector<PadD>& vel, std::vector<PadD>&
   return e;
 }
 
-void GridShellTerms::contact_forces(std::size_t s, const std::vector<Vec3d>& X,
-                                    std::vector<Vec3d>& f) const {
-  const ShellContact& c = *sh_[s].gs->contact;
-  for (std::size_t p = 0; p < c.num_sites(); ++p) {
-    Mat3d G;
-    site_energy(c, X, p, a3_[site_start_[s] + p], &G);
-    scatter_tangential(c, p, G, -1.0, f);
-  }
-}
-
 void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseMatrixD& J,
                            SparseMatrixD& K) {
   move(vel);
@@ -379,17 +370,31 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
       const int pr = a0 + 3 * static_cast<int>(p);
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) tk.emplace_back(pr + i, pr + j, H(6 + i, 6 + j));
-      // d^2 psi / dX_k da3E = sum_beta dN_k/dxi_beta d^2 psi / da_beta da3E.
+      // d^2 psi / dX_k da3E = sum_beta dN_k/dxi_beta d^2 psi / da_beta da3E, and the
+      // tangential part d^2 psi / dX_k dX_l = sum_beta,gamma dN_k/dxi_beta dN_l/dxi_gamma
+      // d^2 psi / da_beta da_gamma (a_beta = sum_k dN_k/dxi_beta X_k).
       const ShellContact::StencilWeight* w = c.weights(p);
       for (std::uint32_t k = c.off[p]; k < c.off[p + 1]; ++k) {
-        const Mat3d B = static_cast<double>(w[k - c.off[p]].N1) * H.block<3, 3>(0, 6) +
-                        static_cast<double>(w[k - c.off[p]].N2) * H.block<3, 3>(3, 6);
+        const double n1 = static_cast<double>(w[k - c.off[p]].N1);
+        const double n2 = static_cast<double>(w[k - c.off[p]].N2);
+        const Mat3d B = n1 * H.block<3, 3>(0, 6) + n2 * H.block<3, 3>(3, 6);
+        const Mat3d T1 = n1 * H.block<3, 3>(0, 0) + n2 * H.block<3, 3>(3, 0);
+        const Mat3d T2 = n1 * H.block<3, 3>(0, 3) + n2 * H.block<3, 3>(3, 3);
         for (int i = 0; i < 3; ++i) {
           const int d = dof_of[s][3 * c.idx[k] + i];
           if (d < 0) continue;
           for (int j = 0; j < 3; ++j) {
             tk.emplace_back(first[s] + d, pr + j, B(i, j));
             tk.emplace_back(pr + j, first[s] + d, B(i, j));
+          }
+          for (std::uint32_t l = c.off[p]; l < c.off[p + 1]; ++l) {
+            const double m1 = static_cast<double>(w[l - c.off[p]].N1);
+            const double m2 = static_cast<double>(w[l - c.off[p]].N2);
+            for (int j = 0; j < 3; ++j) {
+              const int e = dof_of[s][3 * c.idx[l] + j];
+              if (e < 0) continue;
+              tk.emplace_back(first[s] + d, first[s] + e, T1(i, j) * m1 + T2(i, j) * m2);
+            }
           }
         }
       }
@@ -404,19 +409,8 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
           if (da >= 0 && db >= 0 && Kc[j](a, b) != 0)
             tk.emplace_back(first[s] + da, first[s] + db, Kc[j](a, b));
         }
-    std::vector<char> movable(n, 0);
-    for (std::size_t k = 0; k < 3 * n; ++k)
-      if (dof_of[s][k] >= 0) movable[k / 3] = 1;
-    const std::vector<std::vector<int>>& coupling = S.kl->coupling;
-    const std::vector<std::vector<int>> groups = colour_points(coupling, movable);
-    const PointForceFn forces = [this, s](const std::vector<Vec3d>& p, std::vector<Vec3d>& f) {
-      sh_[s].kl->kl->energy(p.data(), f.data(), serial_, false);
-      contact_forces(s, p, f);
-    };
-    std::vector<Vec3d> f0(n, Vec3d::Zero());
-    forces(S.X, f0);
-    const SparseMatrixD Kx =
-        fd_stiffness(forces, S.X, f0, dof_of[s], nfree[s], coupling, groups, 1e-8 * S.length);
+    // The Kirchhoff-Love part from each quadrature point's Hessian (kl_stiffness.h).
+    const SparseMatrixD Kx = kl_stiffness_matrix(*S.kl->kl, S.X, dof_of[s], nfree[s], serial_);
     for (Eigen::Index col = 0; col < Kx.outerSize(); ++col)
       for (SparseMatrixD::InnerIterator it(Kx, col); it; ++it)
         tk.emplace_back(first[s] + static_cast<int>(it.row()),

@@ -14,10 +14,11 @@
 // in the explicit path. Everything is double; the weights are the float ones G2P uses.
 //
 // Preconditioner (prepare): the Hessian of the shells' terms in their own unknowns, the
-// control points and the contact particles' a3E (Kirchhoff-Love and contact tangential
-// stiffness by finite differences of the forces, fd_stiffness.h; each contact particle's
-// Hessian by differences of its gradient, made positive semi-definite), brought to the
-// nodes by Woodbury's identity with a lumped coupling (see prepare).
+// control points and the contact particles' a3E (Kirchhoff-Love from each quadrature
+// point's Hessian, kl_stiffness.h; each contact particle's Hessian in (a_1, a_2, a3E) by
+// differences of its gradient, made positive semi-definite, brought to its control points
+// and a3E by the chain rule), brought to the nodes by Woodbury's identity with a lumped
+// coupling (see prepare).
 #pragma once
 #include <array>
 #include <memory>
@@ -113,8 +114,6 @@ class GridShellTerms {
   double evaluate(bool grad);
   /// J and K at vel (see prepare); N: the objective's size.
   void joint(const std::vector<PadD>& vel, Eigen::Index N, SparseMatrixD& J, SparseMatrixD& K);
-  /// Contact tangential forces at X with the given a3E (for fd_stiffness), added to f.
-  void contact_forces(std::size_t s, const std::vector<Vec3d>& X, std::vector<Vec3d>& f) const;
 
   /// The collider penalty of the control points at X into S.dX (with grad) and its
   /// Hessian kappa n n^T (with K: per control point, zero if none); returns its energy.

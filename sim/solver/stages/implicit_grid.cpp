@@ -1,5 +1,6 @@
 #include "sim/solver/stages/implicit_grid.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "sim/core/simulation_error.h"
@@ -37,7 +38,13 @@ void ImplicitGridStage::run(StepContext& c) {
   }
   for (std::size_t s = 0; s < kls_.size(); ++s) c.grid_shells[s].shell->sync_double_kl(*kls_[s].kl);
   const NewtonOptions opt = newton_options(shot);
-  double dt = c.dt;
+  if (cap_epoch_ != c.advance_epoch) {
+    cap_ = 0;
+    cap_epoch_ = c.advance_epoch;
+  }
+  double dt = cap_ > 0 ? std::min(c.dt, cap_) : c.dt;
+  bool retried = false;
+  int iterations = 0;
   while (true) {
     for (Collider& col : c.colliders) col.begin_step(c.time, dt);
     if (!c.colliders.empty()) {
@@ -54,7 +61,9 @@ void ImplicitGridStage::run(StepContext& c) {
     }
     const NewtonReport rep = implicit_grid_step(in, dt, opt);
     c.implicit_frame.add(rep.iterations, rep.cg_iterations, rep.residual);
+    iterations = rep.iterations;
     if (rep.converged) break;
+    retried = true;
     ++c.implicit_frame.retries;
     dt *= 0.5;
     if (dt < shot.dt_min) {
@@ -69,6 +78,10 @@ void ImplicitGridStage::run(StepContext& c) {
       throw SimulationError(os.str());
     }
   }
+  if (retried)
+    cap_ = dt;
+  else if (cap_ > 0 && 3 * iterations <= opt.max_iterations)
+    cap_ = 2 * dt;
   c.dt = dt;
   // Pinned control points: their velocity over the step actually taken.
   for (GridShell& g : c.grid_shells) prescribe_pins(*g.shell, c.time, dt, g.held);
