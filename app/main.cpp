@@ -119,9 +119,11 @@ int main(int argc, char** argv) {
                    "KEY=V1,V2,V3 (repeatable: keys varied together, as many values each)")
       ->required();
   converge_cmd
-      ->add_option("--measure", converge.measure,
-                   "quantity: shell.NAME.lowest, shell.NAME.centroid.y, bulk.max.x, "
-                   "stats.kinetic_energy, max:stats.KEY, ... (see README)")
+      ->add_option(
+          "--measure", converge.measure,
+          "quantity: shell.NAME.lowest, shell.NAME.centroid.y, bulk.max.x, "
+          "stats.kinetic_energy, max:stats.KEY, ... (docs/accuracy.md, \"Convergence for your "
+          "own shot\")")
       ->required();
   converge_cmd->add_option("--frames", converge.frames, "frame range A-B of every run");
   converge_cmd->add_option("--at", converge.at_frame, "frame measured (default: the last)")

@@ -24,8 +24,14 @@
 // threads: seconds per frame, steps, Newton and CG, and the sheet's permanent dent (the
 // static shape of its plastic state after the ball has left).
 //
+// Then cloth in contact: scenes/cloth_drape.yaml (a cloth of 1,681 control points dropped
+// on a sphere collider and the ground, contact on the grid) over its first D frames
+// (--drape-frames, default 12: the fall, the impact at frame 5 and the drape), explicit and
+// implicit at up to a frame per step: seconds per frame, steps, Newton and CG.
+//
 //   implicit_vs_explicit [--frames F] [--threads 1,2] [--explicit-frames E]
 //                        [--no-dent | --dent-only] [--no-grid-dent] [--no-explicit-dent]
+//                        [--drape-frames D] [--no-drape | --drape-only]
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -188,11 +194,33 @@ void dent(double dt_max, double cfl, int threads, bool direct = false, double th
       t.per_step(t.newton), t.per_step(t.cg), plastic, 1e3 * (0.1 - low));
 }
 
+/// scenes/cloth_drape.yaml to frame `frames`, explicit or implicit (dt_max one frame).
+void drape(bool implicit, int frames, int threads) {
+  Scene s = read_scene(std::string(SHELLMPM_SOURCE_DIR) + "/scenes/cloth_drape.yaml");
+  if (implicit) {
+    s.shot.integrator = Integrator::Implicit;
+    s.shot.dt_max = 1.0 / s.shot.fps;
+  }
+  ThreadLimit limit(threads);
+  Solver solver(s);
+  Totals t;
+  for (int f = 2; f <= frames; ++f) t.add(shellmpm_bench::timed_advance(solver, 1.0 / s.shot.fps));
+  double low = 1e9;
+  for (const Vec3& x : solver.shells()[0]->x) low = std::min(low, static_cast<double>(x.y()));
+  std::printf(
+      "  %-9s threads %d: %7.3f s/frame over frames 2-%d, %7.1f steps/frame, Newton %5.1f CG "
+      "%6.1f per step, retries %ld; lowest control point %.4f m\n",
+      implicit ? "implicit" : "explicit", threads, t.seconds / (frames - 1), frames,
+      static_cast<double>(t.steps) / (frames - 1), t.per_step(t.newton), t.per_step(t.cg),
+      t.retries, low);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int frames = 6, explicit_frames = 2;
+  int frames = 6, explicit_frames = 2, drape_frames = 12;
   bool with_dent = true, dent_only = false, grid_dent = true, explicit_dent = true;
+  bool with_drape = true, drape_only = false;
   int kept = 1;  // --no-dent takes no value: taken out before the value options
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-dent")
@@ -203,6 +231,10 @@ int main(int argc, char** argv) {
       grid_dent = false;
     else if (std::string(argv[i]) == "--no-explicit-dent")
       explicit_dent = false;
+    else if (std::string(argv[i]) == "--no-drape")
+      with_drape = false;
+    else if (std::string(argv[i]) == "--drape-only")
+      drape_only = true;
     else
       argv[kept++] = argv[i];
   }
@@ -213,8 +245,13 @@ int main(int argc, char** argv) {
           argc, argv,
           {{"--frames", [&](const char* v) { frames = std::atoi(v); }},
            {"--explicit-frames", [&](const char* v) { explicit_frames = std::atoi(v); }},
+           {"--drape-frames", [&](const char* v) { drape_frames = std::max(2, std::atoi(v)); }},
            {"--threads", [&](const char* v) { threads = parse_int_list(v); }}}))
     return 2;
+  if (drape_only) {
+    with_dent = false;
+    dent_only = true;
+  }
   for (const Case& c : {aluminium_strip(), steel_sheet()}) {
     if (dent_only) break;
     Solver probe(c.scene);
@@ -228,6 +265,11 @@ int main(int argc, char** argv) {
       run(c, 0, explicit_frames, t);
       for (int spf : {1, 10, 100}) run(c, spf, frames, t);
     }
+  }
+  if (with_drape && (drape_only || !dent_only)) {
+    std::printf("cloth_drape (scenes/cloth_drape.yaml, contact on the grid, 24 fps):\n");
+    for (int t : threads)
+      for (const bool implicit : {false, true}) drape(implicit, drape_frames, t);
   }
   if (!with_dent) return 0;
   std::printf("steel dent without contact (scenes/steel_dent.yaml, contact: off, 24 fps):\n");

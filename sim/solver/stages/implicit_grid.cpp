@@ -81,7 +81,7 @@ void ImplicitGridStage::run(StepContext& c) {
   if (retried)
     cap_ = dt;
   else if (cap_ > 0 && 3 * iterations <= opt.max_iterations)
-    cap_ = 2 * dt;
+    cap_ = std::max(2 * cap_, 2 * dt);  // grows from the cap, not from a short step
   c.dt = dt;
   // Pinned control points: their velocity over the step actually taken.
   for (GridShell& g : c.grid_shells) prescribe_pins(*g.shell, c.time, dt, g.held);
