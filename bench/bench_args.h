@@ -26,10 +26,19 @@ struct Option {
 };
 
 /// Parses `--name value` pairs against `options`; prints the offending argument (unknown,
-/// or without a value) and returns false on the first bad one.
+/// or without a value) and returns false on the first bad one. `--help` (or `-h`) lists
+/// the options and exits 0.
 inline bool parse_options(int argc, char** argv, const std::vector<Option>& options) {
   for (int i = 1; i < argc; i += 2) {
     const std::string k = argv[i];
+    if (k == "--help" || k == "-h") {
+      std::printf("usage: %s", argv[0]);
+      for (const Option& c : options) std::printf(" [%s VALUE]", c.name);
+      std::printf(
+          "\nwhat it measures and what each option means: the comment at the top of "
+          "its source file in bench/\n");
+      std::exit(0);
+    }
     const Option* o = nullptr;
     for (const Option& c : options)
       if (k == c.name) o = &c;
