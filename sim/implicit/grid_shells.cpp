@@ -420,28 +420,86 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
   K.setFromTriplets(tk.begin(), tk.end());
 }
 
-void GridShellTerms::prepare(const std::vector<PadD>& vel, const VecXd& minv) {
-  SparseMatrixD K;
-  joint(vel, minv.size(), J_, K);
-  // S~ = the absolute row sums of J M^-1 J^T (>= it, so the preconditioner stays positive
-  // definite), and the factor of K + S~^-1.
-  const VecXd colsum = SparseMatrixD(J_.cwiseAbs().transpose()) * VecXd::Ones(J_.rows());
-  const VecXd s = J_.cwiseAbs() * minv.cwiseProduct(colsum);
-  const double floor = 1e-12 * std::max(s.maxCoeff(), 1e-300);
-  sinv_ = s.cwiseMax(floor).cwiseInverse();
-  SparseMatrixD A = K;
-  for (Eigen::Index k = 0; k < A.rows(); ++k) A.coeffRef(k, k) += sinv_[k];
-  ldlt_ = factorise_positive(A);
+void GridShellTerms::prepare(const std::vector<PadD>& vel, const SparseMatrixD& minv) {
+  SparseMatrixD J, K;
+  joint(vel, minv.rows(), J, K);
+  // S = J M^-1 J^T: control points and contact particles that share nodes couple.
+  const SparseMatrixD S = (J * minv * SparseMatrixD(J.transpose())).pruned();
+  // Only the joint unknowns that reach a node and have stiffness enter J^T K J (K is
+  // positive semi-definite: a zero diagonal entry is a zero row).
+  const VecXd kd = K.diagonal(), sd = S.diagonal();
+  std::vector<int> kept_of(static_cast<std::size_t>(J.rows()), -1);
+  int m = 0;
+  double kmax = 0, smax = 0;
+  for (Eigen::Index r = 0; r < J.rows(); ++r)
+    if (kd[r] > 0 && sd[r] > 0) {
+      kept_of[static_cast<std::size_t>(r)] = m++;
+      kmax = std::max(kmax, kd[r]);
+      smax = std::max(smax, sd[r]);
+    }
+  ldlt_.reset();
+  exact_ = false;
+  if (m == 0) return;
+  std::vector<Eigen::Triplet<double>> tp;
+  for (Eigen::Index r = 0; r < J.rows(); ++r)
+    if (kept_of[static_cast<std::size_t>(r)] >= 0)
+      tp.emplace_back(kept_of[static_cast<std::size_t>(r)], r, 1.0);
+  SparseMatrixD P(m, J.rows());
+  P.setFromTriplets(tp.begin(), tp.end());
+  J_ = P * J;
+  const SparseMatrixD Pt = P.transpose();
+  const SparseMatrixD Sk = P * S * Pt, Kk = P * K * Pt;
+  exact_ = m <= exact_limit_;
+  if (!exact_) {
+    // S~ = the absolute row sums of S (S~ >= S, so the approximation stays positive
+    // definite), and (K^-1 + S~)^-1 = S~^-1 - S~^-1 (K + S~^-1)^-1 S~^-1.
+    sinv_ = (Sk.cwiseAbs() * VecXd::Ones(m)).cwiseInverse();
+    SparseMatrixD A = Kk;
+    for (int k = 0; k < m; ++k) A.coeffRef(k, k) += sinv_[k];
+    ldlt_ = factorise_positive(A);
+    return;
+  }
+  // Exact: (K^-1 + S)^-1 y = w from the quasi-definite system [S I; I -K] [w; q] = [y; 0]
+  // (w = K q, q = (I + S K)^-1 y), defined where K is singular (a free sheet's rigid
+  // motions). Tiny shifts on both blocks keep it quasi-definite, so LDL^T exists for the
+  // fill-reducing order without pivoting.
+  const double es = 1e-12 * smax, ek = 1e-12 * kmax;
+  std::vector<Eigen::Triplet<double>> ta;
+  const auto add = [&](const SparseMatrixD& X, int off, double sign, double shift) {
+    for (Eigen::Index col = 0; col < X.outerSize(); ++col) {
+      for (SparseMatrixD::InnerIterator it(X, col); it; ++it)
+        ta.emplace_back(off + static_cast<int>(it.row()), off + static_cast<int>(col),
+                        sign * it.value());
+      ta.emplace_back(off + static_cast<int>(col), off + static_cast<int>(col), sign * shift);
+    }
+  };
+  add(Sk, 0, 1.0, es);
+  add(Kk, m, -1.0, ek);
+  for (int i = 0; i < m; ++i) {
+    ta.emplace_back(i, m + i, 1.0);
+    ta.emplace_back(m + i, i, 1.0);
+  }
+  SparseMatrixD A(2 * m, 2 * m);
+  A.setFromTriplets(ta.begin(), ta.end());
+  ldlt_ = std::make_unique<SparseLdlt>();
+  ldlt_->compute(A);
+  if (ldlt_->info() != Eigen::Success) ldlt_.reset();
 }
 
-void GridShellTerms::apply(const VecXd& r, const VecXd& minv, VecXd& z) const {
-  z = minv.cwiseProduct(r);
+void GridShellTerms::apply(const VecXd& r, const SparseMatrixD& minv, VecXd& z) const {
+  z = minv * r;
   if (!ldlt_) return;
-  const VecXd y = J_ * z;
-  const VecXd w = sinv_.cwiseProduct(y);
-  const VecXd t = ldlt_->solve(w);
-  const VecXd yy = w - sinv_.cwiseProduct(t);
-  z -= minv.cwiseProduct(J_.transpose() * yy);
+  VecXd w;
+  if (exact_) {
+    const Eigen::Index m = J_.rows();
+    VecXd rhs = VecXd::Zero(2 * m);
+    rhs.head(m) = J_ * z;
+    w = ldlt_->solve(rhs).head(m);
+  } else {
+    const VecXd y = sinv_.cwiseProduct(J_ * z);
+    w = y - sinv_.cwiseProduct(ldlt_->solve(y));
+  }
+  z -= minv * (J_.transpose() * w);
 }
 
 void GridShellTerms::add_diagonal(const std::vector<PadD>& vel, VecXd& diag) {
