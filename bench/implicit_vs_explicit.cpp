@@ -31,7 +31,8 @@
 //
 //   implicit_vs_explicit [--frames F] [--threads 1,2] [--explicit-frames E]
 //                        [--no-dent | --dent-only] [--no-grid-dent] [--no-explicit-dent]
-//                        [--drape-frames D] [--no-drape | --drape-only]
+//                        [--drape-frames D] [--no-drape | --drape-only] [--grid-dent-only]
+//                        [--grid-steps N,...]  (the grid dent at 1/(240 N) s instead)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -220,7 +221,7 @@ void drape(bool implicit, int frames, int threads) {
 int main(int argc, char** argv) {
   int frames = 6, explicit_frames = 2, drape_frames = 12;
   bool with_dent = true, dent_only = false, grid_dent = true, explicit_dent = true;
-  bool with_drape = true, drape_only = false;
+  bool with_drape = true, drape_only = false, grid_dent_only = false;
   int kept = 1;  // --no-dent takes no value: taken out before the value options
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--no-dent")
@@ -235,25 +236,29 @@ int main(int argc, char** argv) {
       with_drape = false;
     else if (std::string(argv[i]) == "--drape-only")
       drape_only = true;
+    else if (std::string(argv[i]) == "--grid-dent-only")
+      grid_dent_only = true;
     else
       argv[kept++] = argv[i];
   }
   argc = kept;
   std::vector<int> threads = {1, 2};
+  std::vector<int> grid_steps;  // steps per 240 fps frame of the grid dent (empty: the default)
   using shellmpm_bench::parse_int_list;
   if (!shellmpm_bench::parse_options(
           argc, argv,
           {{"--frames", [&](const char* v) { frames = std::atoi(v); }},
            {"--explicit-frames", [&](const char* v) { explicit_frames = std::atoi(v); }},
            {"--drape-frames", [&](const char* v) { drape_frames = std::max(2, std::atoi(v)); }},
-           {"--threads", [&](const char* v) { threads = parse_int_list(v); }}}))
+           {"--threads", [&](const char* v) { threads = parse_int_list(v); }},
+           {"--grid-steps", [&](const char* v) { grid_steps = parse_int_list(v); }}}))
     return 2;
   if (drape_only) {
     with_dent = false;
     dent_only = true;
   }
   for (const Case& c : {aluminium_strip(), steel_sheet()}) {
-    if (dent_only) break;
+    if (dent_only || grid_dent_only) break;
     Solver probe(c.scene);
     ShellObject& sh = *probe.shells()[0];
     std::printf("%s: %zu control points, explicit stable step %.3g s (%.0f per frame)\n",
@@ -266,14 +271,16 @@ int main(int argc, char** argv) {
       for (int spf : {1, 10, 100}) run(c, spf, frames, t);
     }
   }
-  if (with_drape && (drape_only || !dent_only)) {
+  if (with_drape && !grid_dent_only && (drape_only || !dent_only)) {
     std::printf("cloth_drape (scenes/cloth_drape.yaml, contact on the grid, 24 fps):\n");
     for (int t : threads)
       for (const bool implicit : {false, true}) drape(implicit, drape_frames, t);
   }
   if (!with_dent) return 0;
-  std::printf("steel dent without contact (scenes/steel_dent.yaml, contact: off, 24 fps):\n");
+  if (!grid_dent_only)
+    std::printf("steel dent without contact (scenes/steel_dent.yaml, contact: off, 24 fps):\n");
   for (int t : threads) {
+    if (grid_dent_only) break;
     if (explicit_dent)
       for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t, true);
     // Implicit at up to a frame per step: the ball's speed bounds the step while it moves
@@ -288,6 +295,10 @@ int main(int argc, char** argv) {
     // converged in time), then implicit at one step per frame down to 1e-4 s.
     if (explicit_dent)
       for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t);
+    if (!grid_steps.empty()) {
+      for (const int n : grid_steps) dent(1.0 / (240.0 * std::max(n, 1)), 0.5, t);
+      continue;
+    }
     for (const double dt : {1.0 / 240, 1.0 / 2400, 1e-4}) dent(dt, 0.5, t);
   }
   return 0;

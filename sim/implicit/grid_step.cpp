@@ -350,7 +350,7 @@ class GridObjective final : public ImplicitObjective {
   double dt_;
   std::size_t nb_ = 0;
   VecXd m_, vhat_, u0_, diag_, base_diag_;
-  SparseMatrixD minv_;  // the diagonal's inverse on the constrained subspace (3x3 blocks)
+  SparseMatrixD minv_;         // the diagonal's inverse on the constrained subspace (3x3 blocks)
   bool shells_ready_ = false;  // the shells' preconditioner is prepared
   int refresh_calls_ = 0;      // refreshes asked for since it was
   std::vector<char> fixed_;
