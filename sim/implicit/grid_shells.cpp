@@ -449,41 +449,41 @@ void GridShellTerms::prepare(const std::vector<PadD>& vel, const SparseMatrixD& 
   J_ = P * J;
   const SparseMatrixD Pt = P.transpose();
   const SparseMatrixD Sk = P * S * Pt, Kk = P * K * Pt;
-  exact_ = m <= exact_limit_;
-  if (!exact_) {
-    // S~ = the absolute row sums of S (S~ >= S, so the approximation stays positive
-    // definite), and (K^-1 + S~)^-1 = S~^-1 - S~^-1 (K + S~^-1)^-1 S~^-1.
-    sinv_ = (Sk.cwiseAbs() * VecXd::Ones(m)).cwiseInverse();
-    SparseMatrixD A = Kk;
-    for (int k = 0; k < m; ++k) A.coeffRef(k, k) += sinv_[k];
-    ldlt_ = factorise_positive(A);
-    return;
-  }
-  // Exact: (K^-1 + S)^-1 y = w from the quasi-definite system [S I; I -K] [w; q] = [y; 0]
-  // (w = K q, q = (I + S K)^-1 y), defined where K is singular (a free sheet's rigid
-  // motions). Tiny shifts on both blocks keep it quasi-definite, so LDL^T exists for the
-  // fill-reducing order without pivoting.
-  const double es = 1e-12 * smax, ek = 1e-12 * kmax;
-  std::vector<Eigen::Triplet<double>> ta;
-  const auto add = [&](const SparseMatrixD& X, int off, double sign, double shift) {
-    for (Eigen::Index col = 0; col < X.outerSize(); ++col) {
-      for (SparseMatrixD::InnerIterator it(X, col); it; ++it)
-        ta.emplace_back(off + static_cast<int>(it.row()), off + static_cast<int>(col),
-                        sign * it.value());
-      ta.emplace_back(off + static_cast<int>(col), off + static_cast<int>(col), sign * shift);
+  if (m <= exact_limit_) {
+    // Exact: (K^-1 + S)^-1 y = w from the quasi-definite system [S I; I -K] [w; q] =
+    // [y; 0] (w = K q, q = (I + S K)^-1 y), defined where K is singular (a free sheet's
+    // rigid motions). Tiny shifts on both blocks keep it quasi-definite, so LDL^T exists
+    // for the fill-reducing order without pivoting (should round-off still break it,
+    // the lumped coupling below takes over).
+    const double es = 1e-12 * smax, ek = 1e-12 * kmax;
+    std::vector<Eigen::Triplet<double>> ta;
+    const auto add = [&](const SparseMatrixD& X, int off, double sign, double shift) {
+      for (Eigen::Index col = 0; col < X.outerSize(); ++col) {
+        for (SparseMatrixD::InnerIterator it(X, col); it; ++it)
+          ta.emplace_back(off + static_cast<int>(it.row()), off + static_cast<int>(col),
+                          sign * it.value());
+        ta.emplace_back(off + static_cast<int>(col), off + static_cast<int>(col), sign * shift);
+      }
+    };
+    add(Sk, 0, 1.0, es);
+    add(Kk, m, -1.0, ek);
+    for (int i = 0; i < m; ++i) {
+      ta.emplace_back(i, m + i, 1.0);
+      ta.emplace_back(m + i, i, 1.0);
     }
-  };
-  add(Sk, 0, 1.0, es);
-  add(Kk, m, -1.0, ek);
-  for (int i = 0; i < m; ++i) {
-    ta.emplace_back(i, m + i, 1.0);
-    ta.emplace_back(m + i, i, 1.0);
+    SparseMatrixD A(2 * m, 2 * m);
+    A.setFromTriplets(ta.begin(), ta.end());
+    ldlt_ = std::make_unique<SparseLdlt>();
+    ldlt_->compute(A);
+    exact_ = ldlt_->info() == Eigen::Success && ldlt_->vectorD().allFinite();
+    if (exact_) return;
   }
-  SparseMatrixD A(2 * m, 2 * m);
-  A.setFromTriplets(ta.begin(), ta.end());
-  ldlt_ = std::make_unique<SparseLdlt>();
-  ldlt_->compute(A);
-  if (ldlt_->info() != Eigen::Success) ldlt_.reset();
+  // Lumped: S~ = the absolute row sums of S (S~ >= S, so the approximation stays
+  // positive definite), and (K^-1 + S~)^-1 = S~^-1 - S~^-1 (K + S~^-1)^-1 S~^-1.
+  sinv_ = (Sk.cwiseAbs() * VecXd::Ones(m)).cwiseInverse();
+  SparseMatrixD A = Kk;
+  for (int k = 0; k < m; ++k) A.coeffRef(k, k) += sinv_[k];
+  ldlt_ = factorise_positive(A);
 }
 
 void GridShellTerms::apply(const VecXd& r, const SparseMatrixD& minv, VecXd& z) const {
