@@ -222,24 +222,25 @@ int main(int argc, char** argv) {
   int frames = 6, explicit_frames = 2, drape_frames = 12;
   bool with_dent = true, dent_only = false, grid_dent = true, explicit_dent = true;
   bool with_drape = true, drape_only = false, grid_dent_only = false;
-  int kept = 1;  // --no-dent takes no value: taken out before the value options
+  // The switches take no value: taken out before the value options.
+  const struct {
+    const char* name;
+    bool* flag;
+    bool value;
+  } switches[] = {
+      {"--no-dent", &with_dent, false},           {"--dent-only", &dent_only, true},
+      {"--no-grid-dent", &grid_dent, false},      {"--no-explicit-dent", &explicit_dent, false},
+      {"--no-drape", &with_drape, false},         {"--drape-only", &drape_only, true},
+      {"--grid-dent-only", &grid_dent_only, true}};
+  int kept = 1;
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--no-dent")
-      with_dent = false;
-    else if (std::string(argv[i]) == "--dent-only")
-      dent_only = true;
-    else if (std::string(argv[i]) == "--no-grid-dent")
-      grid_dent = false;
-    else if (std::string(argv[i]) == "--no-explicit-dent")
-      explicit_dent = false;
-    else if (std::string(argv[i]) == "--no-drape")
-      with_drape = false;
-    else if (std::string(argv[i]) == "--drape-only")
-      drape_only = true;
-    else if (std::string(argv[i]) == "--grid-dent-only")
-      grid_dent_only = true;
-    else
-      argv[kept++] = argv[i];
+    bool matched = false;
+    for (const auto& s : switches)
+      if (std::string(argv[i]) == s.name) {
+        *s.flag = s.value;
+        matched = true;
+      }
+    if (!matched) argv[kept++] = argv[i];
   }
   argc = kept;
   std::vector<int> threads = {1, 2};
@@ -277,16 +278,16 @@ int main(int argc, char** argv) {
       for (const bool implicit : {false, true}) drape(implicit, drape_frames, t);
   }
   if (!with_dent) return 0;
-  if (!grid_dent_only)
+  if (!grid_dent_only) {
     std::printf("steel dent without contact (scenes/steel_dent.yaml, contact: off, 24 fps):\n");
-  for (int t : threads) {
-    if (grid_dent_only) break;
-    if (explicit_dent)
-      for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t, true);
-    // Implicit at up to a frame per step: the ball's speed bounds the step while it moves
-    // (cfl dx / 10 m/s), then the sheet's own motion does.
-    for (const double cfl : {0.5, 0.25, 0.125}) dent(1.0 / 24, cfl, t, true);
-    dent(1e-4, 0.5, t, true);
+    for (int t : threads) {
+      if (explicit_dent)
+        for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t, true);
+      // Implicit at up to a frame per step: the ball's speed bounds the step while it
+      // moves (cfl dx / 10 m/s), then the sheet's own motion does.
+      for (const double cfl : {0.5, 0.25, 0.125}) dent(1.0 / 24, cfl, t, true);
+      dent(1e-4, 0.5, t, true);
+    }
   }
   if (!grid_dent) return 0;
   std::printf("steel dent (scenes/steel_dent.yaml, contact on the grid, 240 fps):\n");
@@ -295,11 +296,10 @@ int main(int argc, char** argv) {
     // converged in time), then implicit at one step per frame down to 1e-4 s.
     if (explicit_dent)
       for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t);
-    if (!grid_steps.empty()) {
-      for (const int n : grid_steps) dent(1.0 / (240.0 * std::max(n, 1)), 0.5, t);
-      continue;
-    }
-    for (const double dt : {1.0 / 240, 1.0 / 2400, 1e-4}) dent(dt, 0.5, t);
+    std::vector<double> steps = {1.0 / 240, 1.0 / 2400, 1e-4};
+    if (!grid_steps.empty()) steps.clear();
+    for (const int n : grid_steps) steps.push_back(1.0 / (240.0 * std::max(n, 1)));
+    for (const double dt : steps) dent(dt, 0.5, t);
   }
   return 0;
 }

@@ -125,19 +125,9 @@ class GridObjective final : public ImplicitObjective {
   }
 
   /// With shells: their part of the Hessian (grid_shells.h, prepare), or with
-  /// block_jacobi its diagonal added to the nodes' own. Factorised, a refresh the Newton
-  /// solve asks for is taken every kRefreshExact calls with the exact coupling and every
-  /// kRefreshLumped with the lumped one (NewtonOptions::refresh_after = 1 leaves the
-  /// choice here). Measured on the steel dent's first moving frame: exact, refreshing at
-  /// every iteration, 219 Newton iterations, 628 CG, 50 s; every 3, 267, 1,157, 25 s;
-  /// every 10, 409, 4,216 and 4 retries, 23 s. The lumped factor is cheaper, its
-  /// preconditioner weaker, and the cloth drape kept 10.
+  /// block_jacobi its diagonal added to the nodes' own.
   void prepare_preconditioner(const VecXd& u) override {
     if (!in_.shells) return;
-    if (in_.factorise && shells_ready_) {
-      const int every = in_.shells->exact() ? kRefreshExact : kRefreshLumped;
-      if (++refresh_calls_ % every != 0) return;
-    }
     scatter(u);
     if (in_.factorise) {
       projected_inverse_diagonal();
@@ -147,6 +137,16 @@ class GridObjective final : public ImplicitObjective {
     }
     diag_ = base_diag_;
     in_.shells->add_diagonal(vbuf_, diag_);
+  }
+
+  /// Factorised shells: every kRefreshExact iterations with the exact coupling, every
+  /// kRefreshLumped with the lumped one. Measured on the steel dent's first moving frame:
+  /// exact, refreshing at every iteration, 219 Newton iterations, 628 CG, 50 s; every 3,
+  /// 267, 1,157, 25 s; every 10, 409, 4,216 and 4 retries, 23 s. The lumped factor is
+  /// cheaper, its preconditioner weaker, and the cloth drape kept 10.
+  int refresh_every() const override {
+    if (!shells_ready_) return 0;
+    return in_.shells->exact() ? kRefreshExact : kRefreshLumped;
   }
 
   void project(VecXd& d) const override {
@@ -352,7 +352,6 @@ class GridObjective final : public ImplicitObjective {
   VecXd m_, vhat_, u0_, diag_, base_diag_;
   SparseMatrixD minv_;         // the diagonal's inverse on the constrained subspace (3x3 blocks)
   bool shells_ready_ = false;  // the shells' preconditioner is prepared
-  int refresh_calls_ = 0;      // refreshes asked for since it was
   std::vector<char> fixed_;
   std::vector<Vec3d> normal_;     // slip constraint normal per node (zero: none)
   std::vector<int> collider_of_;  // the collider of that constraint (-1: none)

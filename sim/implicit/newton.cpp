@@ -88,7 +88,8 @@ NewtonReport newton_minimise(ImplicitObjective& obj, VecXd& u, const NewtonOptio
     if (!std::isfinite(rep.residual)) break;
     const bool small = rep.residual <= opt.tolerance;
     if (!small && rep.iterations >= opt.max_iterations) break;
-    if (rep.iterations > 0 && opt.refresh_after > 0 && rep.iterations % opt.refresh_after == 0)
+    const int every = obj.refresh_every() > 0 ? obj.refresh_every() : opt.refresh_after;
+    if (rep.iterations > 0 && every > 0 && rep.iterations % every == 0)
       obj.prepare_preconditioner(u);
     // Where P^-1 g looks converged, CG solves tightly: its step is the convergence test
     // below, and a loose CG stops early for the same reason P^-1 g looks small (both

@@ -38,9 +38,12 @@ class ImplicitObjective {
   /// out = H(u) d for a projected d. Default: central difference of the gradient,
   /// (g(u + h d) - g(u - h d)) / 2h with h = 1e-6 (1 + |u|_inf) / |d|_inf.
   virtual void hessian_product(const VecXd& u, const VecXd& d, VecXd& out);
-  /// Builds the preconditioner at u (called once per solve, at the start, or every
-  /// iteration with NewtonOptions::refresh_after = 1). Default: none.
+  /// Builds the preconditioner at u (called once per solve, at the start, and again every
+  /// refresh_every() iterations). Default: none.
   virtual void prepare_preconditioner(const VecXd& u) { (void)u; }
+  /// How many iterations the preconditioner is worth keeping, for an objective that knows
+  /// better than NewtonOptions::refresh_after (asked after each build; 0: the options).
+  virtual int refresh_every() const { return 0; }
   /// z = P^-1 r (a symmetric positive definite approximation of H^-1). Default: z = r.
   virtual void apply_preconditioner(const VecXd& r, VecXd& z) const { z = r; }
   /// Zeroes the constrained entries of a direction.

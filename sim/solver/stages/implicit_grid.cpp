@@ -37,8 +37,7 @@ void ImplicitGridStage::run(StepContext& c) {
       kls_[s].kl = c.grid_shells[s].shell->double_kl(&kls_[s].coupling);
   }
   for (std::size_t s = 0; s < kls_.size(); ++s) c.grid_shells[s].shell->sync_double_kl(*kls_[s].kl);
-  NewtonOptions opt = newton_options(shot);
-  opt.refresh_after = 1;  // the objective refreshes its preconditioner as it needs (grid_step.cpp)
+  const NewtonOptions opt = newton_options(shot);
   if (cap_epoch_ != c.advance_epoch) {
     cap_ = 0;
     cap_epoch_ = c.advance_epoch;

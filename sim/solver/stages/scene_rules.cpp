@@ -53,7 +53,8 @@ NewtonOptions newton_options(const ShotSettings& s) {
   // iterations, 2356 CG and a retry (19.5 s) without a refresh; 28, 338 and none (4.9 s)
   // refreshing every 10; later frames, which converge sooner, unchanged. (That was with
   // a finite-difference tangent; the shells without contact now refresh every other
-  // iteration, implicit_shells.cpp. The grid solve keeps 10.)
+  // iteration, implicit_shells.cpp, and the grid solve with shells as its objective
+  // says, grid_step.cpp.)
   o.refresh_after = 10;
   return o;
 }
