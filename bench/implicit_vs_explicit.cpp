@@ -33,9 +33,11 @@
 //                        [--no-dent | --dent-only] [--no-grid-dent] [--no-explicit-dent]
 //                        [--drape-frames D] [--no-drape | --drape-only] [--grid-dent-only]
 //                        [--grid-steps N,...]  (the grid dent at 1/(240 N) s instead)
+//                        [--grid-dx D]  (the grid dent's cell size instead of 2 cm)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -153,9 +155,11 @@ void run(const Case& c, int steps_per_frame, int frames, int threads) {
 /// (`direct` false): its two moving 240 fps frames. Without (`direct`: the control points
 /// are the unknowns and meet the ball through the collider projection and penalty): one
 /// 24 fps frame, with the theta method's theta.
-void dent(double dt_max, double cfl, int threads, bool direct = false, double theta = 1) {
+void dent(double dt_max, double cfl, int threads, bool direct = false, double theta = 1,
+          double dx = 0) {
   Scene s = read_scene(std::string(SHELLMPM_SOURCE_DIR) + "/scenes/steel_dent.yaml");
   s.shot.cfl = cfl;
+  if (dx > 0) s.shot.dx = dx;
   s.shot.dt_min = std::min(s.shot.dt_min, 1e-8);
   if (direct) {
     s.shells[0].contact = ShellDesc::Contact::Off;
@@ -188,6 +192,8 @@ void dent(double dt_max, double cfl, int threads, bool direct = false, double th
     std::snprintf(what, sizeof what, "implicit dt_max %.3g s cfl %.3g", dt_max, cfl);
   else
     std::snprintf(what, sizeof what, "explicit CFL %.3g", cfl);
+  if (dx > 0)
+    std::snprintf(what + std::strlen(what), sizeof what - std::strlen(what), " dx %g", dx);
   std::printf(
       "  %-26s threads %d: %8.3f s/frame, %8.1f steps/frame, Newton %5.1f CG %7.1f per step; "
       "plastic work %.3g J, permanent dent %.2f mm\n",
@@ -245,6 +251,7 @@ int main(int argc, char** argv) {
   argc = kept;
   std::vector<int> threads = {1, 2};
   std::vector<int> grid_steps;  // steps per 240 fps frame of the grid dent (empty: the default)
+  double grid_dx = 0;           // the grid dent's cell size (0: the scene's)
   using shellmpm_bench::parse_int_list;
   if (!shellmpm_bench::parse_options(
           argc, argv,
@@ -252,7 +259,8 @@ int main(int argc, char** argv) {
            {"--explicit-frames", [&](const char* v) { explicit_frames = std::atoi(v); }},
            {"--drape-frames", [&](const char* v) { drape_frames = std::max(2, std::atoi(v)); }},
            {"--threads", [&](const char* v) { threads = parse_int_list(v); }},
-           {"--grid-steps", [&](const char* v) { grid_steps = parse_int_list(v); }}}))
+           {"--grid-steps", [&](const char* v) { grid_steps = parse_int_list(v); }},
+           {"--grid-dx", [&](const char* v) { grid_dx = std::atof(v); }}}))
     return 2;
   if (drape_only) {
     with_dent = false;
@@ -295,11 +303,11 @@ int main(int argc, char** argv) {
     // The explicit reference at its stable step and at half of it (how far it has
     // converged in time), then implicit at one step per frame down to 1e-4 s.
     if (explicit_dent)
-      for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t);
+      for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t, false, 1, grid_dx);
     std::vector<double> steps = {1.0 / 240, 1.0 / 2400, 1e-4};
     if (!grid_steps.empty()) steps.clear();
     for (const int n : grid_steps) steps.push_back(1.0 / (240.0 * std::max(n, 1)));
-    for (const double dt : steps) dent(dt, 0.5, t);
+    for (const double dt : steps) dent(dt, 0.5, t, false, 1, grid_dx);
   }
   return 0;
 }

@@ -283,7 +283,7 @@ double GridShellTerms::gradient(const std::vector<PadD>& vel, std::vector<PadD>&
   return e;
 }
 
-void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseMatrixD& J,
+void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseMatrixD* J,
                            SparseMatrixD& K) {
   move(vel);
   advance_sites(vel);
@@ -304,7 +304,7 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
   // J: dX/du = dt w (control rows), da3E/du = dt g . a3E^n (contact particle rows).
   std::vector<Eigen::Triplet<double>> tj;
   const std::uint32_t nc = table_.num_control_points();
-  for (std::size_t b = 0; b < grid_.num_particle_blocks(); ++b) {
+  for (std::size_t b = 0; J && b < grid_.num_particle_blocks(); ++b) {
     const Vec3i bc = corner_of(grid_, b);
     each_shell_point(grid_, b, static_cast<std::uint32_t>(table_.size()), [&](std::uint32_t g) {
       const std::size_t s = table_.shell(g);
@@ -331,8 +331,10 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
       });
     });
   }
-  J.resize(first.back(), N);
-  J.setFromTriplets(tj.begin(), tj.end());
+  if (J) {
+    J->resize(first.back(), N);
+    J->setFromTriplets(tj.begin(), tj.end());
+  }
   // K: the Kirchhoff-Love and contact Hessian in (X, a3E).
   std::vector<Eigen::Triplet<double>> tk;
   for (std::size_t s = 0; s < sh_.size(); ++s) {
@@ -421,10 +423,16 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
 }
 
 void GridShellTerms::prepare(const std::vector<PadD>& vel, const SparseMatrixD& minv) {
-  SparseMatrixD J, K;
-  joint(vel, minv.rows(), J, K);
-  // S = J M^-1 J^T: control points and contact particles that share nodes couple.
-  const SparseMatrixD S = (J * minv * SparseMatrixD(J.transpose())).pruned();
+  SparseMatrixD K;
+  // J and minv are the same at every prepare of one step (the weights, a3E^n and the
+  // nodes' constraints are fixed within it): J and S = J M^-1 J^T, whose coupling of the
+  // control points and contact particles that share nodes is the costly product, are
+  // formed once.
+  const bool first = Jall_.rows() == 0;
+  joint(vel, minv.rows(), first ? &Jall_ : nullptr, K);
+  if (first) Sall_ = (Jall_ * minv * SparseMatrixD(Jall_.transpose())).pruned();
+  const SparseMatrixD& J = Jall_;
+  const SparseMatrixD& S = Sall_;
   // Only the joint unknowns that reach a node and have stiffness enter J^T K J (K is
   // positive semi-definite: a zero diagonal entry is a zero row).
   const VecXd kd = K.diagonal(), sd = S.diagonal();
@@ -473,9 +481,14 @@ void GridShellTerms::prepare(const std::vector<PadD>& vel, const SparseMatrixD& 
     }
     SparseMatrixD A(2 * m, 2 * m);
     A.setFromTriplets(ta.begin(), ta.end());
-    ldlt_ = std::make_unique<SparseLdlt>();
-    ldlt_->compute(A);
-    exact_ = ldlt_->info() == Eigen::Success && ldlt_->vectorD().allFinite();
+    if (!qd_) qd_ = std::make_unique<SymmetricFactor>();
+    exact_ = qd_->factorise(A);
+    if (exact_) {
+      // Round-off that broke the factor shows as a non-finite solve.
+      VecXd probe;
+      qd_->solve(VecXd::Ones(A.rows()), probe);
+      exact_ = probe.allFinite();
+    }
     if (exact_) return;
   }
   // Lumped: S~ = the absolute row sums of S (S~ >= S, so the approximation stays
@@ -488,13 +501,15 @@ void GridShellTerms::prepare(const std::vector<PadD>& vel, const SparseMatrixD& 
 
 void GridShellTerms::apply(const VecXd& r, const SparseMatrixD& minv, VecXd& z) const {
   z = minv * r;
-  if (!ldlt_) return;
+  if (!exact_ && !ldlt_) return;
   VecXd w;
   if (exact_) {
     const Eigen::Index m = J_.rows();
     VecXd rhs = VecXd::Zero(2 * m);
     rhs.head(m) = J_ * z;
-    w = ldlt_->solve(rhs).head(m);
+    VecXd sol;
+    qd_->solve(rhs, sol);
+    w = sol.head(m);
   } else {
     const VecXd y = sinv_.cwiseProduct(J_ * z);
     w = y - sinv_.cwiseProduct(ldlt_->solve(y));
@@ -504,7 +519,7 @@ void GridShellTerms::apply(const VecXd& r, const SparseMatrixD& minv, VecXd& z) 
 
 void GridShellTerms::add_diagonal(const std::vector<PadD>& vel, VecXd& diag) {
   SparseMatrixD J, K;
-  joint(vel, diag.size(), J, K);
+  joint(vel, diag.size(), &J, K);
   const SparseMatrixD KJ = K * J;
   for (Eigen::Index col = 0; col < J.outerSize(); ++col) {
     double d = 0;

@@ -29,6 +29,7 @@
 #include "sim/contact/shell_transfer.h"
 #include "sim/implicit/collider_penalty.h"
 #include "sim/implicit/newton.h"
+#include "sim/implicit/symmetric_factor.h"
 #include "sim/shell/fd_stiffness.h"
 #include "sim/shell/kirchhoff_love.h"
 
@@ -43,10 +44,11 @@ struct GridShellKl {
 };
 
 /// The largest joint space (control-point components and contact-particle normals with
-/// stiffness) whose coupling the preconditioner keeps exactly (see prepare). Measured on
-/// the steel dent's first moving frame (2 threads): at 1,938 unknowns (15 x 15) exact
-/// 26 s against lumped 67 s; at about 4,900 (24 x 24) exact 296 s against 159 s.
-constexpr int kExactCouplingLimit = 3000;
+/// stiffness) whose coupling the preconditioner keeps exactly (see prepare). Measured (2
+/// threads, the exact factor by MUMPS): the steel dent's first moving frame at 1,938
+/// unknowns (15 x 15) exact 15 s against lumped 67 s, at about 4,900 (24 x 24) 115 s
+/// against 154 s; cloth_drape's first six frames (14,643) 163 s against 140 s.
+constexpr int kExactCouplingLimit = 8000;
 
 class GridShellTerms {
  public:
@@ -75,17 +77,19 @@ class GridShellTerms {
   /// The preconditioner's shell part at vel (objective dofs 3 (g kBlockNodes + n) + a;
   /// minv: the inverse of the rest of the objective's Hessian, the nodes' mass and bulk
   /// diagonal, on the constrained subspace: 3x3 blocks Pi D^-1 Pi^T per node, zero where
-  /// a node is fixed). With the joint unknowns y = (the free control-point components,
-  /// every contact particle's a3E), y = J u + const, and K their Hessian (Kirchhoff-Love
-  /// and contact, made positive semi-definite), the Hessian is M + J^T K J; by Woodbury
-  /// its inverse is M^-1 - M^-1 J^T (K^-1 + S)^-1 J M^-1 with S = J M^-1 J^T, which
-  /// couples the control points and contact particles that share nodes.
-  /// Joint spaces up to the exact limit (kExactCouplingLimit unknowns with stiffness) keep
-  /// S exactly: (K^-1 + S)^-1 comes from one sparse LDL^T of the quasi-definite
-  /// [S I; I -K] of twice their size, and the preconditioner inverts the shells' part of
-  /// the Hessian (CG then needs 1-3 iterations a Newton step on the steel dent against
-  /// about 200). Larger ones (a cloth of 1,681 control points and 3,200 contact particles:
-  /// 14,643 unknowns, whose factor has 17 million entries and takes 12 s) lump S into S~,
+  /// a node is fixed; the same at every call on one GridShellTerms). With the joint unknowns y =
+  /// (the free control-point components, every contact particle's a3E), y = J u + const, and K
+  /// their Hessian (Kirchhoff-Love and contact, made positive semi-definite), the Hessian is M +
+  /// J^T K J; by Woodbury its inverse is M^-1 - M^-1 J^T (K^-1 + S)^-1 J M^-1 with S = J M^-1 J^T,
+  /// which couples the control points and contact particles that share nodes. Joint spaces up to
+  /// the exact limit (kExactCouplingLimit unknowns with stiffness) keep S exactly: (K^-1 + S)^-1
+  /// comes from one sparse LDL^T of the quasi-definite [S I; I -K] of twice their size, and the
+  /// preconditioner inverts the shells' part of the Hessian (CG then needs 1-3 iterations a Newton
+  /// step on the steel dent against about 200). The factor is MUMPS's (symmetric_factor.h); J and S
+  /// are formed at the step's first prepare and kept (J and minv are fixed within a step), and the
+  /// factor's analysis is reused while the pattern holds. Larger ones (a cloth of 1,681 control
+  /// points and 3,200 contact particles: 14,643 unknowns, whose factor has 17 million
+  /// entries and takes 2-3 s) lump S into S~,
   /// its absolute row sums (S~ >= S, so the approximation stays positive definite), and
   /// apply (K^-1 + S~)^-1 as S~^-1 - S~^-1 (K + S~^-1)^-1 S~^-1: one factorisation of K's
   /// size and sparsity.
@@ -130,8 +134,8 @@ class GridShellTerms {
   void advance_sites(const std::vector<PadD>& vel);
   /// Energy at the moved state; with `grad`, dE/dX into Shell::dX and dE/da3E into G3_.
   double evaluate(bool grad);
-  /// J and K at vel (see prepare); N: the objective's size.
-  void joint(const std::vector<PadD>& vel, Eigen::Index N, SparseMatrixD& J, SparseMatrixD& K);
+  /// K at vel, and J with J non-null (see prepare); N: the objective's size.
+  void joint(const std::vector<PadD>& vel, Eigen::Index N, SparseMatrixD* J, SparseMatrixD& K);
 
   /// The collider penalty of the control points at X into S.dX (with grad) and its
   /// Hessian kappa n n^T (with K: per control point, zero if none); returns its energy.
@@ -146,8 +150,10 @@ class GridShellTerms {
   std::vector<Site> sites_;
   std::vector<std::uint32_t> site_start_;  ///< per shell: its first entry in sites_
   std::vector<Vec3d> a3_, G3_;             ///< per site: a3E(u), V dpsi/da3E
-  SparseMatrixD J_;                        ///< prepare's J
-  std::unique_ptr<SparseLdlt> ldlt_;       ///< prepare's factor (see exact_)
+  SparseMatrixD Jall_, Sall_;              ///< J and S of every joint unknown (the step's)
+  SparseMatrixD J_;                        ///< prepare's J (the kept rows)
+  std::unique_ptr<SymmetricFactor> qd_;    ///< the exact coupling's factor (kept: its analysis)
+  std::unique_ptr<SparseLdlt> ldlt_;       ///< the lumped coupling's factor
   VecXd sinv_;                             ///< lumped: S~^-1
   bool exact_ = false;                     ///< the last prepare coupled exactly
   int exact_limit_ = kExactCouplingLimit;
