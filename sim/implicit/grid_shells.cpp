@@ -448,15 +448,22 @@ void GridShellTerms::prepare(const std::vector<PadD>& vel, const SparseMatrixD& 
   ldlt_.reset();
   exact_ = false;
   if (m == 0) return;
-  std::vector<Eigen::Triplet<double>> tp;
-  for (Eigen::Index r = 0; r < J.rows(); ++r)
-    if (kept_of[static_cast<std::size_t>(r)] >= 0)
-      tp.emplace_back(kept_of[static_cast<std::size_t>(r)], r, 1.0);
-  SparseMatrixD P(m, J.rows());
-  P.setFromTriplets(tp.begin(), tp.end());
-  J_ = P * J;
-  const SparseMatrixD Pt = P.transpose();
-  const SparseMatrixD Sk = P * S * Pt, Kk = P * K * Pt;
+  if (kept_of != kept_) {
+    // The kept rows change only where a row's stiffness appears or vanishes: J's and S's
+    // kept parts are formed again only then.
+    kept_ = kept_of;
+    std::vector<Eigen::Triplet<double>> tp;
+    for (Eigen::Index r = 0; r < J.rows(); ++r)
+      if (kept_of[static_cast<std::size_t>(r)] >= 0)
+        tp.emplace_back(kept_of[static_cast<std::size_t>(r)], r, 1.0);
+    P_.resize(m, J.rows());
+    P_.setFromTriplets(tp.begin(), tp.end());
+    Pt_ = P_.transpose();
+    J_ = P_ * J;
+    Sk_ = P_ * S * Pt_;
+  }
+  const SparseMatrixD& Sk = Sk_;
+  const SparseMatrixD Kk = P_ * K * Pt_;
   if (m <= exact_limit_) {
     // Exact: (K^-1 + S)^-1 y = w from the quasi-definite system [S I; I -K] [w; q] =
     // [y; 0] (w = K q, q = (I + S K)^-1 y), defined where K is singular (a free sheet's

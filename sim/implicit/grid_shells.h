@@ -151,7 +151,9 @@ class GridShellTerms {
   std::vector<std::uint32_t> site_start_;  ///< per shell: its first entry in sites_
   std::vector<Vec3d> a3_, G3_;             ///< per site: a3E(u), V dpsi/da3E
   SparseMatrixD Jall_, Sall_;              ///< J and S of every joint unknown (the step's)
-  SparseMatrixD J_;                        ///< prepare's J (the kept rows)
+  std::vector<int> kept_;                  ///< per joint unknown its kept row, or -1
+  SparseMatrixD P_, Pt_;                   ///< the kept rows' selection and its transpose
+  SparseMatrixD J_, Sk_;                   ///< J and S on the kept rows
   std::unique_ptr<SymmetricFactor> qd_;    ///< the exact coupling's factor (kept: its analysis)
   std::unique_ptr<SparseLdlt> ldlt_;       ///< the lumped coupling's factor
   VecXd sinv_;                             ///< lumped: S~^-1
