@@ -5,7 +5,8 @@
 // for every symmetric ordering (Vanderbei 1995), so the fill-reducing order (AMD) stands
 // and the factor's dense fronts go to BLAS-3 kernels. On the steel dent's matrix (3,876
 // rows) it takes about 60 ms against 118 ms for Eigen's simplicial LDL^T, on the cloth
-// drape's (29,286 rows) 2.2 s against 8.5 s (one thread; docs/implicit.md).
+// drape's (29,286 rows) 2.2 s against 8.5 s (one thread; docs/implicit.md;
+// bench/factor_bench times both on such a system built for a flat sheet).
 //
 // Independent of the thread count: MUMPS's sequential library runs on the calling thread,
 // and its BLAS (OpenBLAS) is held to one thread. Its bits depend on the BLAS kernels
