@@ -83,13 +83,7 @@ Case aluminium_strip() {
 
 Case steel_sheet() {
   Case c{"steel sheet 0.5 mm", base_scene()};
-  ShellMaterialDesc m;
-  m.name = "steel";
-  m.youngs_modulus = 2e11;
-  m.poisson_ratio = 0.3;
-  m.density = 7850;
-  m.thickness = 5e-4;
-  c.scene.shell_materials.push_back(m);
+  c.scene.shell_materials.push_back(shellmpm::test::steel_sheet_material());
   ShellDesc sh = shellmpm::test::free_sheet("sheet", 0.2, 16);
   sh.pressure = 200;
   for (const double x : {-0.1, 0.1}) {

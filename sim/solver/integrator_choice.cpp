@@ -2,27 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 #include "sim/mpm/constitutive.h"
 #include "sim/shell/shell_object.h"
+#include "sim/solver/number_format.h"
 #include "sim/solver/stages/scene_rules.h"
 
 namespace shellmpm {
 namespace {
 
 std::string g3(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
+  return format_number("%.3g", v);
 }
 
 /// A count of steps, whole.
 std::string whole(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.0f", v);
-  return buf;
+  return format_number("%.0f", v);
 }
 
 }  // namespace

@@ -2,24 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
+#include "sim/solver/number_format.h"
 #include "sim/solver/solver.h"
 
 namespace shellmpm {
 namespace {
 
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-
 /// Three significant digits; whole numbers from 100 to 1e5 without an exponent (5857 m/s).
 std::string num(double v) {
   const double a = std::abs(v);
-  return fmt(a >= 100 && a < 1e5 ? "%.0f" : "%.3g", v);
+  return format_number(a >= 100 && a < 1e5 ? "%.0f" : "%.3g", v);
 }
 
 /// A length in mm below 1 cm, else in m.
@@ -292,7 +286,7 @@ std::string describe_step_limits(const std::vector<StepLimit>& limits, double dt
   for (std::size_t i = 0; i < limits.size(); ++i) {
     const StepLimit& l = limits[i];
     if (i > 0 && !(l.dt < dt_min)) break;
-    out += (i == 0 ? "limited by " : "; also ") + l.detail + " (" + fmt("%.2g", l.dt) +
+    out += (i == 0 ? "limited by " : "; also ") + l.detail + " (" + format_number("%.2g", l.dt) +
            " s); to raise it: " + l.hint;
   }
   const StepLimitKind k = limits.front().kind;

@@ -28,6 +28,18 @@ inline ShellMaterialDesc cloth_material() {
   return m;
 }
 
+/// Sheet steel: E 2e11 Pa, nu 0.3, 7850 kg/m^3, 0.5 mm (scenes/steel_dent.yaml's, without
+/// its yield stress).
+inline ShellMaterialDesc steel_sheet_material() {
+  ShellMaterialDesc m;
+  m.name = "steel";
+  m.youngs_modulus = 2e11;
+  m.poisson_ratio = 0.3;
+  m.density = 7850;
+  m.thickness = 5e-4;
+  return m;
+}
+
 /// The clamped strip of scenes/study/cantilever_gravity.yaml (n = 16, contact off): free
 /// length L = 0.2 m, width 0.05 m, one control row behind the clamp, which pins the rows
 /// x <= h = L / 16 (the limit surface is then clamped at x = 0).

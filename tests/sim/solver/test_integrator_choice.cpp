@@ -50,16 +50,6 @@ ShellDesc hanging_sheet(bool needle) {
   return d;
 }
 
-ShellMaterialDesc steel_sheet() {
-  ShellMaterialDesc m;
-  m.name = "steel";
-  m.youngs_modulus = 2e11;
-  m.poisson_ratio = 0.3;
-  m.density = 7850;
-  m.thickness = 0.5e-3;
-  return m;
-}
-
 /// The smallest bound of the solver's stiffness kinds (shell, contact, material waves).
 double solver_stiffness_dt(const Scene& scene) {
   Scene e = scene;
@@ -108,7 +98,7 @@ TEST_CASE("integrator auto: each rule picks its integrator, with the explicit bo
   }
   SECTION("a steel sheet without contact: above dt_min, but too many steps a frame") {
     Scene s = base_scene();
-    s.shell_materials.push_back(steel_sheet());
+    s.shell_materials.push_back(test::steel_sheet_material());
     s.shells.push_back(hanging_sheet(false));
     const IntegratorChoice c = choose_integrator(s);
     INFO(c.reason);
@@ -119,7 +109,7 @@ TEST_CASE("integrator auto: each rule picks its integrator, with the explicit bo
   }
   SECTION("the same steel sheet on the grid (contact with a collider): explicit") {
     Scene s = base_scene();
-    s.shell_materials.push_back(steel_sheet());
+    s.shell_materials.push_back(test::steel_sheet_material());
     s.shells.push_back(hanging_sheet(false));
     s.shells[0].contact = ShellDesc::Contact::On;
     s.colliders.push_back(test::sphere_collider("ball", Vec3d(0, -0.3, 0), 0.1));
