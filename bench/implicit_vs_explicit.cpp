@@ -69,13 +69,8 @@ Scene base_scene() {
 
 Case aluminium_strip() {
   Case c{"aluminium strip 1 mm", base_scene()};
-  ShellMaterialDesc m;
-  m.name = "aluminium";
-  m.youngs_modulus = 7e10;
-  m.poisson_ratio = 0.33;
-  m.density = 2700;
-  m.thickness = 1e-3;
-  c.scene.shell_materials.push_back(m);
+  c.scene.shell_materials.push_back(
+      shellmpm::test::shell_material("aluminium", 7e10, 0.33, 2700, 1e-3));
   const ShellDesc sh = shellmpm::test::clamped_strip("strip");
   c.scene.shells.push_back(sh);
   return c;

@@ -17,27 +17,27 @@ inline ContactParams contact_params() {
   return p;
 }
 
+/// A shell material: E [Pa], nu, rho [kg/m^3], thickness h [m]; the rest the defaults.
+inline ShellMaterialDesc shell_material(const std::string& name, double E, double nu, double rho,
+                                        double h) {
+  ShellMaterialDesc m;
+  m.name = name;
+  m.youngs_modulus = E;
+  m.poisson_ratio = nu;
+  m.density = rho;
+  m.thickness = h;
+  return m;
+}
+
 /// A light cotton-like cloth: E 2e5 Pa, nu 0.3, 300 kg/m^3, 1 mm.
 inline ShellMaterialDesc cloth_material() {
-  ShellMaterialDesc m;
-  m.name = "cloth";
-  m.youngs_modulus = 2e5;
-  m.poisson_ratio = 0.3;
-  m.density = 300;
-  m.thickness = 1e-3;
-  return m;
+  return shell_material("cloth", 2e5, 0.3, 300, 1e-3);
 }
 
 /// Sheet steel: E 2e11 Pa, nu 0.3, 7850 kg/m^3, 0.5 mm (scenes/steel_dent.yaml's, without
 /// its yield stress).
 inline ShellMaterialDesc steel_sheet_material() {
-  ShellMaterialDesc m;
-  m.name = "steel";
-  m.youngs_modulus = 2e11;
-  m.poisson_ratio = 0.3;
-  m.density = 7850;
-  m.thickness = 5e-4;
-  return m;
+  return shell_material("steel", 2e11, 0.3, 7850, 5e-4);
 }
 
 /// The clamped strip of scenes/study/cantilever_gravity.yaml (n = 16, contact off): free
