@@ -4,7 +4,7 @@ set -e
 PKGS="build-essential cmake pkg-config libeigen3-dev libtbb-dev libopenvdb-dev \
 libboost-iostreams-dev libblosc-dev libembree-dev libassimp-dev libosmesa6-dev catch2 \
 libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libpng-dev libosd-dev ffmpeg clang-format \
-python3-matplotlib libmumps-seq-dev libopenblas0"
+python3-matplotlib libmumps-seq-5.5 libmumps-headers-dev libopenblas0"
 MISSING=""
 for p in $PKGS; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || MISSING="$MISSING $p"

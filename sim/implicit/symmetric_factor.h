@@ -1,6 +1,6 @@
 // A sparse symmetric factorisation for the implicit grid step's preconditioner: the
 // quasi-definite system [S I; I -K] of the shells' exact coupling (grid_shells.h).
-// MUMPS's multifrontal LDL^T (Debian's libmumps-seq-dev) without pivoting: a
+// MUMPS's multifrontal LDL^T (Debian's libmumps-seq-5.5) without pivoting: a
 // quasi-definite matrix (both diagonal blocks definite, here by tiny shifts) has an LDL^T
 // for every symmetric ordering (Vanderbei 1995), so the fill-reducing order (AMD) stands
 // and the factor's dense fronts go to BLAS-3 kernels. On the steel dent's matrix (3,876
