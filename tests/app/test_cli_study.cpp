@@ -127,7 +127,7 @@ TEST_CASE("CLI: the full study runs every problem within its budget; the converg
   INFO(r.output.substr(r.output.size() > 4000 ? r.output.size() - 4000 : 0));
   REQUIRE(r.code == 0);
   const nlohmann::json j = nlohmann::json::parse(read_text(out + "/results.json"));
-  CHECK(j["problems"].size() == 8);
+  CHECK(j["problems"].size() == 9);
   for (const nlohmann::json& p : j["problems"]) {
     const std::string name = p["name"];
     INFO(name);
@@ -137,10 +137,13 @@ TEST_CASE("CLI: the full study runs every problem within its budget; the converg
       CHECK(run["status"] != "skipped");  // the default budget holds the whole study
     }
     // Problems with a smooth answer converge: the error falls at every refinement and the
-    // Richardson limit lands within 0.5% of the reference.
+    // Richardson limit lands within 0.5% of the reference. The bar's contact time falls at
+    // every refinement too, to within 0.5% at the finest grid, but not at a steady order
+    // (surface contact with the wall moves with the particle spacing), so it has no limit.
     const bool smooth = name == "plate_simply_supported" || name == "cantilever_gravity" ||
-                        name == "cantilever_vibration" || name == "bar_impact";
-    if (!smooth) continue;
+                        name == "cantilever_vibration";
+    const bool falls = smooth || name == "bar_impact";
+    if (!falls) continue;
     const nlohmann::json& sweep = p["sweeps"][0];
     REQUIRE(sweep["refinement"] == true);
     double previous = INFINITY;
@@ -148,6 +151,10 @@ TEST_CASE("CLI: the full study runs every problem within its budget; the converg
       const double e = std::abs(p["runs"][i]["error"].get<double>());
       CHECK(e < previous);
       previous = e;
+    }
+    if (!smooth) {
+      CHECK(previous < 0.005);  // a relative error
+      continue;
     }
     REQUIRE(sweep.contains("richardson"));
     const double ref = p["runs"][sweep["runs"][0].get<int>()]["reference"];
