@@ -34,6 +34,8 @@
 //                        [--drape-frames D] [--no-drape | --drape-only] [--grid-dent-only]
 //                        [--grid-steps N,...]  (the grid dent at 1/(240 N) s instead)
 //                        [--grid-dx D]  (the grid dent's cell size instead of 2 cm)
+//                        [--grid-kc K]  (the grid dent's normal contact stiffness [Pa]
+//                                        instead of E; the shear stays E)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -145,10 +147,15 @@ void run(const Case& c, int steps_per_frame, int frames, int threads) {
 /// are the unknowns and meet the ball through the collider projection and penalty): one
 /// 24 fps frame, with the theta method's theta.
 void dent(double dt_max, double cfl, int threads, bool direct = false, double theta = 1,
-          double dx = 0) {
+          double dx = 0, double kc = 0) {
   Scene s = read_scene(std::string(SHELLMPM_SOURCE_DIR) + "/scenes/steel_dent.yaml");
   s.shot.cfl = cfl;
   if (dx > 0) s.shot.dx = dx;
+  if (kc > 0) {
+    ShellMaterialDesc& m = s.shell_materials.at(0);
+    m.contact_shear = m.contact_shear.value_or(m.contact_stiffness.value_or(m.youngs_modulus));
+    m.contact_stiffness = kc;
+  }
   s.shot.dt_min = std::min(s.shot.dt_min, 1e-8);
   if (direct) {
     s.shells[0].contact = ShellDesc::Contact::Off;
@@ -183,6 +190,8 @@ void dent(double dt_max, double cfl, int threads, bool direct = false, double th
     std::snprintf(what, sizeof what, "explicit CFL %.3g", cfl);
   if (dx > 0)
     std::snprintf(what + std::strlen(what), sizeof what - std::strlen(what), " dx %g", dx);
+  if (kc > 0)
+    std::snprintf(what + std::strlen(what), sizeof what - std::strlen(what), " k_c %g", kc);
   std::printf(
       "  %-26s threads %d: %8.3f s/frame, %8.1f steps/frame, Newton %5.1f CG %7.1f per step; "
       "plastic work %.3g J, permanent dent %.2f mm\n",
@@ -241,6 +250,7 @@ int main(int argc, char** argv) {
   std::vector<int> threads = {1, 2};
   std::vector<int> grid_steps;  // steps per 240 fps frame of the grid dent (empty: the default)
   double grid_dx = 0;           // the grid dent's cell size (0: the scene's)
+  double grid_kc = 0;           // the grid dent's normal contact stiffness (0: the scene's)
   using shellmpm_bench::parse_int_list;
   if (!shellmpm_bench::parse_options(
           argc, argv,
@@ -249,7 +259,8 @@ int main(int argc, char** argv) {
            {"--drape-frames", [&](const char* v) { drape_frames = std::max(2, std::atoi(v)); }},
            {"--threads", [&](const char* v) { threads = parse_int_list(v); }},
            {"--grid-steps", [&](const char* v) { grid_steps = parse_int_list(v); }},
-           {"--grid-dx", [&](const char* v) { grid_dx = std::atof(v); }}}))
+           {"--grid-dx", [&](const char* v) { grid_dx = std::atof(v); }},
+           {"--grid-kc", [&](const char* v) { grid_kc = std::atof(v); }}}))
     return 2;
   if (drape_only) {
     with_dent = false;
@@ -292,11 +303,11 @@ int main(int argc, char** argv) {
     // The explicit reference at its stable step and at half of it (how far it has
     // converged in time), then implicit at one step per frame down to 1e-4 s.
     if (explicit_dent)
-      for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t, false, 1, grid_dx);
+      for (const double cfl : {0.5, 0.25}) dent(0.0, cfl, t, false, 1, grid_dx, grid_kc);
     std::vector<double> steps = {1.0 / 240, 1.0 / 2400, 1e-4};
     if (!grid_steps.empty()) steps.clear();
     for (const int n : grid_steps) steps.push_back(1.0 / (240.0 * std::max(n, 1)));
-    for (const double dt : steps) dent(dt, 0.5, t, false, 1, grid_dx);
+    for (const double dt : steps) dent(dt, 0.5, t, false, 1, grid_dx, grid_kc);
   }
   return 0;
 }
