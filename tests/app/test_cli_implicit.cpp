@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/atomic_file.h"
 #include "io/ply_reader.h"
 #include "tests/app/cli_harness.h"
 
@@ -67,8 +68,7 @@ TEST_CASE("can_on_sand: the plate crushes the can into the sand, the can keeps a
     INFO("frame " << f["frame"]);
     CHECK(f["integrity"]["ok"].get<bool>());  // nothing through the can or into the plate
     const shellmpm::PlyMesh m = shellmpm::read_ply(
-        d.file("out/can." + std::string(4 - std::to_string(f["frame"].get<int>()).size(), '0') +
-               std::to_string(f["frame"].get<int>()) + ".ply"));
+        shellmpm::frame_path(d.file("out"), "can.####.ply", f["frame"].get<int>()));
     float lo = INFINITY, hi = -INFINITY;
     for (const auto& p : m.positions) {
       lo = std::min(lo, p.y());
