@@ -2,11 +2,12 @@
 // moves to X_j inside a collider (posed at the end of the step) adds
 //   kappa_j phi(X_j)^2 / 2,   kappa_j = kColliderPenalty max(m_j / dt^2, E h),
 // to the objective: its inertia over the step or the sheet's membrane stiffness,
-// whichever is larger, times 100, so the point ends within about 1% of the depth it
-// would have reached without it. Used by the grid solve (grid_shells.h: the nodes'
-// constraints reach a control point only through stencil nodes inside the collider) and
-// by the shells without contact (shell_step.h: nothing else stops them). The projection
-// after the step (particle_projection.h) then puts the point on the surface.
+// whichever is larger, times 10, so the point ends within about 10% of the depth it
+// would have reached without it. (100 held it within 1% and made the can on sand's
+// solves take a third more Newton iterations: docs/implicit.md.) Used by the grid solve
+// (grid_shells.h: the nodes' constraints reach a control point only through stencil nodes inside
+// the collider) and by the shells without contact (shell_step.h: nothing else stops them). The
+// projection after the step (particle_projection.h) then puts the point on the surface.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -17,7 +18,7 @@
 namespace shellmpm {
 
 /// The collider penalty's stiffness over max(m / dt^2, E h).
-constexpr double kColliderPenalty = 100.0;
+constexpr double kColliderPenalty = 10.0;
 
 struct ColliderPenaltyInput {
   const std::vector<Collider>* colliders = nullptr;  ///< posed for the step; null: none

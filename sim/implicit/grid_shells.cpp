@@ -411,8 +411,15 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
           if (da >= 0 && db >= 0 && Kc[j](a, b) != 0)
             tk.emplace_back(first[s] + da, first[s] + db, Kc[j](a, b));
         }
-    // The Kirchhoff-Love part from each quadrature point's Hessian (kl_stiffness.h).
-    const SparseMatrixD Kx = kl_stiffness_matrix(*S.kl->kl, S.X, dof_of[s], nfree[s], serial_);
+    // The Kirchhoff-Love part from each quadrature point's Hessian (kl_stiffness.h), made
+    // positive semi-definite as the contact particles' are: K enters the quasi-definite
+    // [S I; I -K] and the lumped K + S~^-1, which are what they are meant to be only for
+    // K >= 0. A compressed membrane's Hessian is indefinite; with it unprojected, the
+    // preconditioner turns indefinite, CG's and the preconditioned gradient's directions
+    // stop descending and the solve fails (the can on sand with contact_stiffness 2e9: the
+    // second step's solve, and every halving of it).
+    const SparseMatrixD Kx =
+        kl_stiffness_matrix(*S.kl->kl, S.X, dof_of[s], nfree[s], serial_, /*psd=*/true);
     for (Eigen::Index col = 0; col < Kx.outerSize(); ++col)
       for (SparseMatrixD::InnerIterator it(Kx, col); it; ++it)
         tk.emplace_back(first[s] + static_cast<int>(it.row()),

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace shellmpm {
 
@@ -66,9 +68,15 @@ CgResult truncated_pcg(ImplicitObjective& obj, const VecXd& u, const VecXd& g, d
   return res;
 }
 
-}  // namespace
+/// SHELLMPM_NEWTON_TRACE (any value) prints each Newton iteration and each solve's
+/// outcome to stderr (docs/implicit.md, "Statistics"): a diagnostic for solves that take
+/// many iterations, not part of any output.
+bool newton_trace() {
+  static const bool on = std::getenv("SHELLMPM_NEWTON_TRACE") != nullptr;
+  return on;
+}
 
-NewtonReport newton_minimise(ImplicitObjective& obj, VecXd& u, const NewtonOptions& opt) {
+NewtonReport newton_solve(ImplicitObjective& obj, VecXd& u, const NewtonOptions& opt) {
   NewtonReport rep;
   const Eigen::Index n = obj.size();
   VecXd g(n), d(n), trial(n), g_trial(n);
@@ -97,7 +105,8 @@ NewtonReport newton_minimise(ImplicitObjective& obj, VecXd& u, const NewtonOptio
     const double eta =
         small ? opt.cg_min_eta
               : std::clamp(std::sqrt(rep.residual / rep.residual0), opt.cg_min_eta, opt.cg_max_eta);
-    rep.cg_iterations += truncated_pcg(obj, u, g, eta, opt.max_cg_iterations, d).iterations;
+    const int cg = truncated_pcg(obj, u, g, eta, opt.max_cg_iterations, d).iterations;
+    rep.cg_iterations += cg;
     if (small) {
       // P^-1 g is small, but a preconditioner far from H^-1 (block Jacobi on a stiff
       // sheet, whose low bending modes it misses by orders of magnitude) makes it small
@@ -133,6 +142,10 @@ NewtonReport newton_minimise(ImplicitObjective& obj, VecXd& u, const NewtonOptio
       }
     }
     ++rep.iterations;
+    if (newton_trace())
+      std::fprintf(stderr, "newton %d: E %.9e J, residual %.3e m/s, CG %d, |d| %.3e m/s, step %g\n",
+                   rep.iterations, e, rep.residual, cg, d.lpNorm<Eigen::Infinity>(),
+                   accepted ? step : 0.0);
     if (!accepted) {
       // Near the solution the decrease a full step promises, -slope, can fall below the
       // round-off of E's sums: Armijo then cannot tell. The full step is still taken when
@@ -162,6 +175,21 @@ NewtonReport newton_minimise(ImplicitObjective& obj, VecXd& u, const NewtonOptio
     obj.gradient(u, g);
     rep.residual = residual(g);
   }
+  return rep;
+}
+
+}  // namespace
+
+NewtonReport newton_minimise(ImplicitObjective& obj, VecXd& u, const NewtonOptions& opt) {
+  NewtonReport rep = newton_solve(obj, u, opt);
+  if (newton_trace())
+    std::fprintf(stderr,
+                 "newton: %d iterations, %d CG, %s, residual %.3e -> %.3e m/s, %zu unknowns\n",
+                 rep.iterations, rep.cg_iterations,
+                 rep.converged            ? "converged"
+                 : rep.line_search_failed ? "line search failed"
+                                          : "not converged",
+                 rep.residual0, rep.residual, static_cast<std::size_t>(u.size()));
   return rep;
 }
 

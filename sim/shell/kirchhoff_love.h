@@ -144,10 +144,12 @@ class KirchhoffLoveShellT {
   /// Hessian is J^T H J with H (15 x 15) from forward differences of the point's exact
   /// adjoints (step h_rel |a_alpha|, symmetrised): 16 point evaluations, where finite
   /// differences of the whole force field take one force evaluation per colour and axis
-  /// (150 on a Loop sheet). Double only.
+  /// (150 on a Loop sheet). Double only. With psd, each point's H is replaced by its
+  /// positive semi-definite part (negative eigenvalues set to zero: the compressed
+  /// membrane's geometric stiffness), so the sum is positive semi-definite.
   void stiffness_blocks(const Vec3T* x, double h_rel,
                         const std::function<void(int, int, const Eigen::Matrix<T, 3, 3>&)>& add,
-                        bool serial = false) const;
+                        bool serial = false, bool psd = false) const;
 
   /// Largest |log s_a| (principal elastic Hencky strain, either sign) over all
   /// quadrature points and layers.

@@ -23,12 +23,25 @@ double& input(kl::PointKinematics<double>& k, int i) {
   return (*v[i / 3])[i % 3];
 }
 
+/// H's positive semi-definite part. A pivoted LDL^T first: most points (stretched or at
+/// rest) are already semi-definite, and that test costs a fraction of the eigensolver.
+void make_psd(Mat15& H) {
+  const double scale = H.diagonal().cwiseAbs().maxCoeff();
+  if (!(scale > 0)) return;
+  const Eigen::LDLT<Mat15> ldlt(H);
+  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() >= -1e-12 * scale).all()) return;
+  const Eigen::SelfAdjointEigenSolver<Mat15> es(H);
+  H = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() *
+      es.eigenvectors().transpose();
+}
+
 }  // namespace
 
 template <class T>
 void KirchhoffLoveShellT<T>::stiffness_blocks(
     const Vec3T* x, double h_rel,
-    const std::function<void(int, int, const Eigen::Matrix<T, 3, 3>&)>& add, bool serial) const {
+    const std::function<void(int, int, const Eigen::Matrix<T, 3, 3>&)>& add, bool serial,
+    bool psd) const {
   static_assert(std::is_same_v<T, double>, "the stiffness is assembled in double");
   const std::size_t nq = area_.size();
   // Hessians in chunks of points (their memory bounded), computed in parallel and added
@@ -58,6 +71,7 @@ void KirchhoffLoveShellT<T>::stiffness_blocks(
               for (int r = 0; r < 15; ++r) H(r, i) = (gp[r] - g0[r]) / h;
             }
             H = (0.5 * (H + H.transpose())).eval();
+            if (psd) make_psd(H);
           }
         },
         serial);
@@ -94,7 +108,7 @@ void KirchhoffLoveShellT<T>::stiffness_blocks(
 
 SparseMatrixD kl_stiffness_matrix(const KirchhoffLoveShellT<double>& kl,
                                   const std::vector<Vec3d>& x, const std::vector<int>& dof_of,
-                                  int dofs, bool serial) {
+                                  int dofs, bool serial, bool psd) {
   // 3x3 blocks per coupled pair, summed per row point (a short list each).
   std::vector<std::vector<std::pair<int, Eigen::Matrix3d>>> rows(x.size());
   kl.stiffness_blocks(
@@ -108,7 +122,7 @@ SparseMatrixD kl_stiffness_matrix(const KirchhoffLoveShellT<double>& kl,
           }
         row.emplace_back(j, B);
       },
-      serial);
+      serial, psd);
   std::vector<Eigen::Triplet<double>> t;
   for (std::size_t i = 0; i < rows.size(); ++i)
     for (const auto& [j, B] : rows[i])
@@ -127,6 +141,6 @@ SparseMatrixD kl_stiffness_matrix(const KirchhoffLoveShellT<double>& kl,
 
 template void KirchhoffLoveShellT<double>::stiffness_blocks(
     const Vec3T*, double, const std::function<void(int, int, const Eigen::Matrix<double, 3, 3>&)>&,
-    bool) const;
+    bool, bool) const;
 
 }  // namespace shellmpm

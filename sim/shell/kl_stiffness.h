@@ -10,9 +10,11 @@
 namespace shellmpm {
 
 /// K = d^2E/dx^2 at x over the numbered degrees of freedom (dof_of[3 i + a]: the row and
-/// column of component a of control point i, or -1), symmetric.
+/// column of component a of control point i, or -1), symmetric. With psd, the sum of each
+/// quadrature point's Hessian made positive semi-definite (a preconditioner's K: positive
+/// semi-definite however the sheet is compressed).
 SparseMatrixD kl_stiffness_matrix(const KirchhoffLoveShellT<double>& kl,
                                   const std::vector<Vec3d>& x, const std::vector<int>& dof_of,
-                                  int dofs, bool serial = false);
+                                  int dofs, bool serial = false, bool psd = false);
 
 }  // namespace shellmpm
