@@ -11,12 +11,21 @@
 
 using namespace shellmpm;
 
-TEST_CASE("KL stiffness: per-point Hessians match finite differences of the forces",
-          "[shell][implicit]") {
+namespace {
+
+/// The steel dent's sheet alone (no contact, no colliders).
+Solver steel_sheet() {
   Scene s = read_scene(std::string(SHELLMPM_SOURCE_DIR) + "/scenes/steel_dent.yaml");
   s.shells[0].contact = ShellDesc::Contact::Off;
   s.colliders.clear();
-  Solver solver(s);
+  return Solver(s);
+}
+
+}  // namespace
+
+TEST_CASE("KL stiffness: per-point Hessians match finite differences of the forces",
+          "[shell][implicit]") {
+  const Solver solver = steel_sheet();
   const ShellObject& sh = *solver.shells()[0];
   std::vector<std::vector<int>> coupling;
   const auto kl = sh.double_kl(&coupling);
@@ -79,10 +88,7 @@ TEST_CASE("KL stiffness: per-point Hessians match finite differences of the forc
 
 TEST_CASE("KL stiffness: the positive semi-definite part of a compressed sheet's",
           "[shell][implicit]") {
-  Scene s = read_scene(std::string(SHELLMPM_SOURCE_DIR) + "/scenes/steel_dent.yaml");
-  s.shells[0].contact = ShellDesc::Contact::Off;
-  s.colliders.clear();
-  Solver solver(s);
+  const Solver solver = steel_sheet();
   const ShellObject& sh = *solver.shells()[0];
   const auto kl = sh.double_kl(nullptr);
   const std::size_t n = sh.size();
