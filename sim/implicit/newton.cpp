@@ -143,8 +143,10 @@ NewtonReport newton_solve(ImplicitObjective& obj, VecXd& u, const NewtonOptions&
     }
     ++rep.iterations;
     if (newton_trace())
-      std::fprintf(stderr, "newton %d: E %.9e J, residual %.3e m/s, CG %d, |d| %.3e m/s, step %g\n",
-                   rep.iterations, e, rep.residual, cg, d.lpNorm<Eigen::Infinity>(),
+      std::fprintf(stderr,
+                   "newton %d: E %.9e J, residual %.3e m/s, CG %d, |d| %.3e m/s, g.d %.3e J, "
+                   "step %g\n",
+                   rep.iterations, e, rep.residual, cg, d.lpNorm<Eigen::Infinity>(), slope,
                    accepted ? step : 0.0);
     if (!accepted) {
       // Near the solution the decrease a full step promises, -slope, can fall below the
