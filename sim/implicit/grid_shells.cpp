@@ -6,6 +6,7 @@
 
 #include "sim/contact/contact_energy.h"
 #include "sim/core/parallel.h"
+#include "sim/core/psd_part.h"
 #include "sim/mpm/apic_stencil.h"
 #include "sim/mpm/bspline.h"
 #include "sim/shell/kl_stiffness.h"
@@ -365,9 +366,8 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
         ym[k] -= h;
         H.col(k) = (grad(yp) - grad(ym)) / (2 * h);
       }
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> es(0.5 * (H + H.transpose()));
-      H = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() *
-          es.eigenvectors().transpose();
+      H = (0.5 * (H + H.transpose())).eval();
+      psd_part(H);
       H *= static_cast<double>(c.volume[p]);
       const int pr = a0 + 3 * static_cast<int>(p);
       for (int i = 0; i < 3; ++i)

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sim/core/parallel.h"
+#include "sim/core/psd_part.h"
 #include "sim/shell/kl_kinematics.h"
 #include "sim/shell/kl_stiffness.h"
 
@@ -30,9 +31,7 @@ void make_psd(Mat15& H) {
   if (!(scale > 0)) return;
   const Eigen::LDLT<Mat15> ldlt(H);
   if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() >= -1e-12 * scale).all()) return;
-  const Eigen::SelfAdjointEigenSolver<Mat15> es(H);
-  H = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() *
-      es.eigenvectors().transpose();
+  psd_part(H);
 }
 
 }  // namespace
