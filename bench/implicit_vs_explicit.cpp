@@ -36,6 +36,8 @@
 //                        [--grid-dx D]  (the grid dent's cell size instead of 2 cm)
 //                        [--grid-kc K]  (the grid dent's normal contact stiffness [Pa]
 //                                        instead of E; the shear stays E)
+//                        [--plasticity-in-solve]  (implicit: denting inside each solve
+//                                        instead of after it, shot.plasticity_in_solve)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -146,10 +148,13 @@ void run(const Case& c, int steps_per_frame, int frames, int threads) {
 /// (`direct` false): its two moving 240 fps frames. Without (`direct`: the control points
 /// are the unknowns and meet the ball through the collider projection and penalty): one
 /// 24 fps frame, with the theta method's theta.
+bool g_plasticity_in_solve = false;  // --plasticity-in-solve: true
+
 void dent(double dt_max, double cfl, int threads, bool direct = false, double theta = 1,
           double dx = 0, double kc = 0) {
   Scene s = read_scene(std::string(SHELLMPM_SOURCE_DIR) + "/scenes/steel_dent.yaml");
   s.shot.cfl = cfl;
+  s.shot.plasticity_in_solve = g_plasticity_in_solve;
   if (dx > 0) s.shot.dx = dx;
   if (kc > 0) {
     ShellMaterialDesc& m = s.shell_materials.at(0);
@@ -231,11 +236,14 @@ int main(int argc, char** argv) {
     const char* name;
     bool* flag;
     bool value;
-  } switches[] = {
-      {"--no-dent", &with_dent, false},           {"--dent-only", &dent_only, true},
-      {"--no-grid-dent", &grid_dent, false},      {"--no-explicit-dent", &explicit_dent, false},
-      {"--no-drape", &with_drape, false},         {"--drape-only", &drape_only, true},
-      {"--grid-dent-only", &grid_dent_only, true}};
+  } switches[] = {{"--no-dent", &with_dent, false},
+                  {"--dent-only", &dent_only, true},
+                  {"--no-grid-dent", &grid_dent, false},
+                  {"--no-explicit-dent", &explicit_dent, false},
+                  {"--no-drape", &with_drape, false},
+                  {"--drape-only", &drape_only, true},
+                  {"--grid-dent-only", &grid_dent_only, true},
+                  {"--plasticity-in-solve", &g_plasticity_in_solve, true}};
   int kept = 1;
   for (int i = 1; i < argc; ++i) {
     bool matched = false;

@@ -271,6 +271,10 @@ ShellImplicitStep::ShellImplicitStep(const ShellObject& sh)
     : kl_(sh.double_kl()), cache_(std::make_unique<StiffnessCache>()) {}
 ShellImplicitStep::~ShellImplicitStep() = default;
 
+void ShellImplicitStep::set_plasticity_in_solve(bool on) {
+  kl_->set_plasticity_in_energy(on);
+}
+
 std::unique_ptr<ImplicitObjective> ShellImplicitStep::objective(
     const ShellObject& sh, const Vec3d& gravity, double t, double dt, double theta,
     ImplicitPreconditioner pre, bool serial, VecXd& u0, const std::vector<Collider>* colliders) {

@@ -50,6 +50,8 @@ class ShellImplicitStep {
   NewtonReport step(ShellObject& sh, const Vec3d& gravity, double t, double dt, double theta,
                     const NewtonOptions& opt, ImplicitPreconditioner pre, bool serial,
                     const std::vector<Collider>* colliders = nullptr, std::uint64_t epoch = 0);
+  /// Denting plasticity inside the solve (KirchhoffLoveShellT::set_plasticity_in_energy).
+  void set_plasticity_in_solve(bool on);
   /// Steps whose preconditioner reused an earlier step's stiffness (for tests).
   long reused_steps() const { return reused_steps_; }
   /// The objective of that step (for tests), and in u0 its starting point (v^n, with

@@ -81,6 +81,10 @@ struct ShotSettings {
   /// Implicit shells without contact: the theta method's weight of the end-of-step forces
   /// (1: backward Euler, damps fast modes; 0.5: trapezoidal, damps nothing).
   double implicit_theta = 1;
+  /// Implicit: denting plasticity inside the solve (each step minimises the return
+  /// mapping's incremental potential: the solve sees the returned stress), or only after
+  /// it (the solve sees the elastic trial stress).
+  bool plasticity_in_solve = false;
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
   enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;

@@ -68,9 +68,9 @@ T denting_project_layer(T mu, T lambda, T yield_stress, const Eigen::Matrix<T, 2
   const Eigen::Matrix2d Fi =
       Fp_inv.template cast<double>() * V * scale.asDiagonal() * V.transpose();
   Fp_inv = Fi.cast<T>();
-  const T released =
-      denting_energy_density(mu, lambda, l_trial) - denting_energy_density(mu, lambda, l);
-  return std::max(released, T(0));
+  // The plastic work: the returned stress times the plastic strain increment.
+  const Eigen::Matrix<T, 2, 1> tau = denting_principal_stress(mu, lambda, l);
+  return std::max(tau.dot(l_trial - l), T(0));
 }
 
 #define SHELLMPM_DENTING_INSTANTIATE(T)                                                       \

@@ -46,8 +46,12 @@ T denting_energy_density(T mu, T lambda, const Eigen::Matrix<T, 2, 1>& l);
 /// Fp_inv: the stored inverse plastic part (F^P)^-1 (2x2). On yield, with
 /// Ce = V diag(sigma^2) V^T, the elastic singular values become sigma' (eq. 36) with the
 /// same U, V (eq. 37), so F^P = (F^E)^-1 F gives Fp_inv <- Fp_inv V diag(sigma'/sigma) V^T.
-/// Returns the released elastic energy density psi(trial) - psi(projected) >= 0 [J/m^3];
-/// 0 and Fp_inv untouched (bitwise) below yield. `yielded` (optional) reports the branch.
+/// Returns the plastic work density tau(l) . (l_trial - l) >= 0 [J/m^3] (the returned
+/// principal stresses times the plastic log-strain increment: the dissipation of the
+/// return, whatever the trial's overshoot; the elastic energy released,
+/// psi(trial) - psi(projected), exceeds it by the overshoot's own energy, which at long
+/// implicit steps is most of it); 0 and Fp_inv untouched (bitwise) below yield.
+/// `yielded` (optional) reports the branch.
 template <class T>
 T denting_project_layer(T mu, T lambda, T yield_stress, const Eigen::Matrix<T, 2, 2>& Ce,
                         Eigen::Matrix<T, 2, 2>& Fp_inv, bool* yielded = nullptr);

@@ -172,6 +172,19 @@ void KirchhoffLoveShellT<T>::build_gather_map() {
 }
 
 template <class T>
+void KirchhoffLoveShellT<T>::set_plasticity_in_energy(bool on) {
+  static_assert(std::is_same_v<T, double> || std::is_same_v<T, float>);
+  if constexpr (std::is_same_v<T, float>) {
+    SHELLMPM_CHECK(!on, "plasticity in the energy is for the double (implicit) shell");
+  }
+  in_energy_ = on && has_plasticity();
+  // denting.h clamps Sum = l_1 + l_2 at sigma_y / (mu + lambda) and Diff = l_1 - l_2 at
+  // sigma_y / (sqrt(3) mu).
+  yield_sum_max_ = yield_ / (mu_ + lambda_);
+  yield_diff_max_ = yield_ / (std::sqrt(T(3)) * mu_);
+}
+
+template <class T>
 void KirchhoffLoveShellT<T>::reset_plastic_state() {
   for (std::size_t i = 0; i < fp_inv_.size(); i += 4) {
     fp_inv_[i] = T(1);
@@ -248,6 +261,7 @@ void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinem
   using V3 = Vec3T;
 
   const bool plastic = !fp_inv_.empty();
+  const kl::LayerYield<T> bounds{yield_sum_max_, yield_diff_max_};
   const T area = area_[q];
   V3 Ga1 = V3::Zero(), Ga2 = V3::Zero(), Gv1 = V3::Zero(), Gv2 = V3::Zero();
   T energy = 0;
@@ -265,7 +279,8 @@ void KirchhoffLoveShellT<T>::eval_kinematics(std::size_t q, const kl::PointKinem
     }
     const T V = area * layer_w_[l];
     T S[3];
-    energy += V * layer_psi(mu_, lambda_, stiffening_, B, m11, m12, m22, grad ? S : nullptr);
+    energy += V * layer_psi(mu_, lambda_, stiffening_, B, m11, m12, m22, grad ? S : nullptr,
+                            in_energy_ ? &bounds : nullptr);
     if (grad) {
       const T s = T(2) * V;
       const V3 dg1 = s * (S[0] * g1 + S[1] * g2);

@@ -133,8 +133,8 @@ class KirchhoffLoveShellT {
 
   /// Denting return mapping (supplement sec. 7) for every quadrature point and layer at
   /// positions x; updates the stored plastic state. Returns the plastic work dissipated
-  /// in this call [J] = sum V (psi_trial - psi_projected) >= 0. No-op (returns 0) when
-  /// yield_stress == 0; a layer below yield is left bitwise unchanged.
+  /// in this call [J] = sum V tau . (l_trial - l) >= 0 (denting_project_layer). No-op (returns 0)
+  /// when yield_stress == 0; a layer below yield is left bitwise unchanged.
   T project_plasticity(const Vec3T* x, bool serial = false);
 
   /// The stiffness d^2E/dx^2 at x as 3x3 blocks per coupled pair of control points: for
@@ -166,6 +166,16 @@ class KirchhoffLoveShellT {
   void set_plastic_state(const std::vector<T>& state);
   /// Resets every layer to F^P = I.
   void reset_plastic_state();
+
+  /// Plasticity in the energy (the implicit solves; double only): with on, each layer's
+  /// energy beyond yield is the denting return's incremental potential (laminate_energy.h,
+  /// Huber's function of the clamped log-stretch sum and difference from the stored
+  /// plastic part), so energy() and its forces are those of the stress that
+  /// project_plasticity() will return to at the same positions, and stiffness_blocks()
+  /// that potential's Hessian. Below yield, bitwise the elastic energy. The stored state
+  /// is unchanged: project_plasticity() after the step updates it.
+  void set_plasticity_in_energy(bool on);
+  bool plasticity_in_energy() const { return in_energy_; }
 
   std::size_t num_quadrature_points() const { return area_.size(); }
   int num_layers() const { return num_layers_; }
@@ -232,6 +242,8 @@ class KirchhoffLoveShellT {
   int num_layers_ = 0;
   T mu_ = 0, lambda_ = 0, yield_ = 0, thickness_ = 0;
   Stiffening stiffening_;
+  bool in_energy_ = false;                    // set_plasticity_in_energy
+  T yield_sum_max_ = 0, yield_diff_max_ = 0;  // its bounds (laminate_energy.h LayerYield)
   double rho_ = 0, thickness_d_ = 0, rest_area_ = 0;
   std::vector<std::size_t> begin_;      // entries of quadrature point q: [begin_[q], begin_[q+1])
   std::vector<int> ctrl_;               // control point of each entry

@@ -40,13 +40,13 @@ T KirchhoffLoveShellT<T>::project_plasticity(const Vec3T* x, bool serial) {
             const Mat2T Ce = Bm.transpose() * M * Bm;
             Mat2T F;
             F << Fi[0], Fi[1], Fi[2], Fi[3];
-            const T released = denting_project_layer(mu_, lambda_, yield_, Ce, F);
+            const T wd = denting_project_layer(mu_, lambda_, yield_, Ce, F);
             // Below yield F is untouched, so this copy is bitwise neutral.
             Fi[0] = F(0, 0);
             Fi[1] = F(0, 1);
             Fi[2] = F(1, 0);
             Fi[3] = F(1, 1);
-            w += double(area_[q] * layer_w_[l]) * double(released);
+            w += double(area_[q] * layer_w_[l]) * double(wd);
           }
         }
         return w;

@@ -55,8 +55,26 @@ inline void metric_adjoint(const T* Bp, T s11, T s12, T s22, T* S) {
 /// s_a, its gradient is g_1 P_1 + g_2 P_2 = a I + b C, b = (g_1 - g_2) / (c_1 - c_2),
 /// a = g_2 - b c_2. Both s_a > s_l: b = k s_l / (s_1 s_2 (s_1 + s_2)) exactly (no
 /// cancellation at s_1 = s_2). Only s_1 > s_l >= s_2: c_1 - c_2 = 2h >= s_1^2 - s_l^2 > 0.
+/// The denting return inside the energy (kirchhoff_love.h, "Plasticity in the energy"):
+/// the bounds of the sums and differences of the log stretches that denting.h's return
+/// mapping clamps to, sum_max = sigma_y / (mu + lambda) and diff_max = sigma_y / (sqrt(3) mu).
+template <class T>
+struct LayerYield {
+  T sum_max, diff_max;
+};
+
+/// Huber's function k x^2 / 2 for |x| <= m, k m (|x| - m / 2) beyond: the least of
+/// k (x - p)^2 / 2 + k m |p| over a plastic part p, whose derivative k clamp(x, -m, m) is
+/// the returned stress.
+template <class T>
+inline T huber(T k, T x, T m) {
+  const T ax = std::abs(x);
+  return ax <= m ? T(0.5) * k * x * x : k * m * (ax - T(0.5) * m);
+}
+
 template <class T, class Stiffening>
-inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m12, T m22, T* S) {
+inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m12, T m22, T* S,
+                   const LayerYield<T>* yield = nullptr) {
   T c11, c12, c22;
   layer_metric(Bp, m11, m12, m22, c11, c12, c22);
   const T tr = c11 + c22;
@@ -68,6 +86,15 @@ inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m
   const T L = std::log(det);  // log c1 + log c2
   const T D = T(2) * x * q;   // log c1 - log c2
   T psi = T(0.125) * mu * (L * L + D * D) + T(0.125) * lambda * L * L;
+  // With the return inside the energy, beyond a bound the Hencky part is the incremental
+  // potential: with Sum = l_1 + l_2 = L / 2 and Diff = l_1 - l_2 = D / 2, Hencky is
+  // (mu + lambda) Sum^2 / 2 + mu Diff^2 / 2, and each term becomes Huber's function of
+  // its bound (denting.h clamps Sum and Diff separately). Its derivatives in
+  // (L, D): a_L = (mu + lambda) clamp(Sum) / 2, a_D = mu clamp(Diff) / 2.
+  const bool yielding =
+      yield && (std::abs(T(0.5) * L) > yield->sum_max || T(0.5) * D > yield->diff_max);
+  if (yielding)
+    psi = huber(mu + lambda, T(0.5) * L, yield->sum_max) + huber(mu, T(0.5) * D, yield->diff_max);
   // Large-stretch term; l1 = log s1 >= l2 = log s2. Untaken below the limit (bitwise Hencky).
   const bool beyond = T(0.25) * (L + D) > st.log_limit;
   T stretch_i = 0, stretch_c = 0;  // its gradient in C: stretch_i I + stretch_c C
@@ -89,8 +116,16 @@ inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m
   if (S) {
     const T beta = T(2) * q / tr;
     const T alpha = T(0.5) * (L - beta * tr);
-    const T k = (T(0.5) * mu * alpha + T(0.25) * lambda * L) / det;
-    const T d = T(0.5) * mu * beta;
+    T k = (T(0.5) * mu * alpha + T(0.25) * lambda * L) / det;
+    T d = T(0.5) * mu * beta;
+    if (yielding) {
+      // dpsi/dC = C^-1 (a_L I + a_D (P_1 - P_2)), P_1 - P_2 = (C - tr / 2 I) / h; below
+      // the Diff bound a_D / h = mu beta / 2 as in Hencky (h may be 0 there).
+      const T sum = std::clamp(T(0.5) * L, -yield->sum_max, yield->sum_max);
+      const T aL = T(0.5) * (mu + lambda) * sum;
+      d = T(0.5) * D > yield->diff_max ? T(0.5) * mu * yield->diff_max / h : T(0.5) * mu * beta;
+      k = (aL - T(0.5) * d * tr) / det;
+    }
     // dpsi/dC = k adj(C) + d I (+ stretch_i I + stretch_c C beyond the limit)
     T s11 = k * c22 + d, s12 = -k * c12, s22 = k * c11 + d;
     if (beyond) {

@@ -36,7 +36,10 @@ void ImplicitGridStage::run(StepContext& c) {
     for (std::size_t s = 0; s < kls_.size(); ++s)
       kls_[s].kl = c.grid_shells[s].shell->double_kl(&kls_[s].coupling);
   }
-  for (std::size_t s = 0; s < kls_.size(); ++s) c.grid_shells[s].shell->sync_double_kl(*kls_[s].kl);
+  for (std::size_t s = 0; s < kls_.size(); ++s) {
+    c.grid_shells[s].shell->sync_double_kl(*kls_[s].kl);
+    kls_[s].kl->set_plasticity_in_energy(shot.plasticity_in_solve);
+  }
   const NewtonOptions opt = newton_options(shot);
   if (cap_epoch_ != c.advance_epoch) {
     cap_ = 0;

@@ -18,6 +18,8 @@ void ImplicitShellsStage::run(StepContext& c) {
   if (steps_.empty())
     for (std::size_t i = 0; i < c.shells.size(); ++i)
       steps_.push_back(c.contacts[i] ? nullptr : std::make_unique<ShellImplicitStep>(*c.shells[i]));
+  for (auto& s : steps_)
+    if (s) s->set_plasticity_in_solve(c.scene.shot.plasticity_in_solve);
   advance(c, c.time, c.dt);
 }
 
