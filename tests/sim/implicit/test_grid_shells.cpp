@@ -176,17 +176,36 @@ TEST_CASE(
   CHECK(std::abs(fd - slope) < 1e-5 * std::abs(slope));
 }
 
+namespace {
+
+/// The rig's objective over a step of 0.01 s, a direction d in its constraints' subspace
+/// and a point u = u0 + 0.2 d along it.
+struct Probe {
+  static constexpr double dt = 0.01;
+  GridShellTerms terms;
+  GridStepInput in;
+  VecXd u0, d, u;
+  std::unique_ptr<ImplicitObjective> obj;
+  explicit Probe(Rig& rig)
+      : terms(rig.grid, rig.table, rig.shells, rig.kls, 0.0, dt, true), in(rig.input(&terms)) {
+    obj = grid_objective(in, dt, u0);
+    d.resize(u0.size());
+    for (Eigen::Index k = 0; k < d.size(); ++k) d[k] = std::sin(1.7 * k + 0.3);
+    obj->project(d);
+    u = u0 + 0.2 * d;
+  }
+};
+
+}  // namespace
+
 TEST_CASE("implicit grid with shells: the gradient matches finite differences", "[implicit]") {
   Rig rig;
-  const double dt = 0.01;
-  GridShellTerms terms(rig.grid, rig.table, rig.shells, rig.kls, 0.0, dt, true);
-  const GridStepInput in = rig.input(&terms);
-  VecXd u0, g;
-  const auto obj = grid_objective(in, dt, u0);
-  VecXd d(u0.size());
-  for (Eigen::Index k = 0; k < d.size(); ++k) d[k] = std::sin(1.7 * k + 0.3);
-  obj->project(d);
-  const VecXd u = u0 + 0.2 * d;
+  Probe pr(rig);
+  const double dt = Probe::dt;
+  const GridStepInput& in = pr.in;
+  const auto& obj = pr.obj;
+  const VecXd &d = pr.d, &u = pr.u;
+  VecXd g;
   obj->gradient(u, g);
   const double slope = g.dot(d);
   REQUIRE(std::abs(slope) > 0);
@@ -220,15 +239,10 @@ TEST_CASE(
   // the objective's Kirchhoff-Love part is the return's incremental potential, only C1
   // where layers cross their bounds, so the differences are short.
   Rig rig(2e5, 1e3);
-  const double dt = 0.01;
-  GridShellTerms terms(rig.grid, rig.table, rig.shells, rig.kls, 0.0, dt, true);
-  const GridStepInput in = rig.input(&terms);
-  VecXd u0, g;
-  const auto obj = grid_objective(in, dt, u0);
-  VecXd d(u0.size());
-  for (Eigen::Index k = 0; k < d.size(); ++k) d[k] = std::sin(1.7 * k + 0.3);
-  obj->project(d);
-  const VecXd u = u0 + 0.2 * d;
+  Probe pr(rig);
+  const auto& obj = pr.obj;
+  const VecXd &d = pr.d, &u = pr.u;
+  VecXd g;
   const double e_elastic = obj->energy(u);
   rig.kls[0].kl->set_plasticity_in_energy(true);
   REQUIRE(rig.kls[0].kl->plasticity_in_energy());
