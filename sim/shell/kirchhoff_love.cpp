@@ -173,7 +173,6 @@ void KirchhoffLoveShellT<T>::build_gather_map() {
 
 template <class T>
 void KirchhoffLoveShellT<T>::set_plasticity_in_energy(bool on) {
-  static_assert(std::is_same_v<T, double> || std::is_same_v<T, float>);
   if constexpr (std::is_same_v<T, float>) {
     SHELLMPM_CHECK(!on, "plasticity in the energy is for the double (implicit) shell");
   }

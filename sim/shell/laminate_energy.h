@@ -42,20 +42,7 @@ inline void metric_adjoint(const T* Bp, T s11, T s12, T s22, T* S) {
   S[2] = r10 * b10 + r11 * b11;
 }
 
-/// Laminate energy density of one layer (supplement secs. 3-4) from the current metric
-/// M = [g_a . g_b] (m11, m12, m22) and Bp (row-major 2x2): C = Bp^T M Bp has eigenvalues
-/// s_a^2 and psi = mu/4 |log C|^2 + lambda/8 (log det C)^2 = mu |log s|^2 +
-/// lambda/2 (tr log s)^2, plus the large-stretch term k sum_a (s_a - s_l)_+^2 (our addition,
-/// kirchhoff_love.h). If S != nullptr writes dpsi/dM (s11, s12, s22; symmetric,
-/// dpsi = sum_ab S_ab dM_ab).
-/// log C = alpha I + beta C with beta = (log c1 - log c2) / (c1 - c2) evaluated as
-/// 2 atanh(x) / (x tr), x = (c1 - c2) / (c1 + c2), which is stable at c1 = c2, and
-/// dpsi/dC = C^-1 (mu/2 log C + lambda/4 log det C I).
-/// The stretch term is a spectral function of C: with g_a = dpsi_s/dc_a = k (s_a - s_l)_+ /
-/// s_a, its gradient is g_1 P_1 + g_2 P_2 = a I + b C, b = (g_1 - g_2) / (c_1 - c_2),
-/// a = g_2 - b c_2. Both s_a > s_l: b = k s_l / (s_1 s_2 (s_1 + s_2)) exactly (no
-/// cancellation at s_1 = s_2). Only s_1 > s_l >= s_2: c_1 - c_2 = 2h >= s_1^2 - s_l^2 > 0.
-/// The denting return inside the energy (kirchhoff_love.h, "Plasticity in the energy"):
+/// The denting return inside the energy (KirchhoffLoveShellT::set_plasticity_in_energy):
 /// the bounds of the sums and differences of the log stretches that denting.h's return
 /// mapping clamps to, sum_max = sigma_y / (mu + lambda) and diff_max = sigma_y / (sqrt(3) mu).
 template <class T>
@@ -72,6 +59,21 @@ inline T huber(T k, T x, T m) {
   return ax <= m ? T(0.5) * k * x * x : k * m * (ax - T(0.5) * m);
 }
 
+/// Laminate energy density of one layer (supplement secs. 3-4) from the current metric
+/// M = [g_a . g_b] (m11, m12, m22) and Bp (row-major 2x2): C = Bp^T M Bp has eigenvalues
+/// s_a^2 and psi = mu/4 |log C|^2 + lambda/8 (log det C)^2 = mu |log s|^2 +
+/// lambda/2 (tr log s)^2, plus the large-stretch term k sum_a (s_a - s_l)_+^2 (our addition,
+/// kirchhoff_love.h). If S != nullptr writes dpsi/dM (s11, s12, s22; symmetric,
+/// dpsi = sum_ab S_ab dM_ab).
+/// log C = alpha I + beta C with beta = (log c1 - log c2) / (c1 - c2) evaluated as
+/// 2 atanh(x) / (x tr), x = (c1 - c2) / (c1 + c2), which is stable at c1 = c2, and
+/// dpsi/dC = C^-1 (mu/2 log C + lambda/4 log det C I).
+/// The stretch term is a spectral function of C: with g_a = dpsi_s/dc_a = k (s_a - s_l)_+ /
+/// s_a, its gradient is g_1 P_1 + g_2 P_2 = a I + b C, b = (g_1 - g_2) / (c_1 - c_2),
+/// a = g_2 - b c_2. Both s_a > s_l: b = k s_l / (s_1 s_2 (s_1 + s_2)) exactly (no
+/// cancellation at s_1 = s_2). Only s_1 > s_l >= s_2: c_1 - c_2 = 2h >= s_1^2 - s_l^2 > 0.
+/// yield (optional): the Hencky part beyond its bounds is the return's incremental
+/// potential (LayerYield, huber).
 template <class T, class Stiffening>
 inline T layer_psi(T mu, T lambda, const Stiffening& st, const T* Bp, T m11, T m12, T m22, T* S,
                    const LayerYield<T>* yield = nullptr) {
