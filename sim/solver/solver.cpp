@@ -223,6 +223,10 @@ void Solver::reorder_particles() {
   ++c_.particle_epoch;
 }
 
+double step_end_time(double time, double dt, double t_end, bool last) {
+  return last || t_end - (time + dt) <= kTimeSnap * dt ? t_end : time + dt;
+}
+
 FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   using clock = std::chrono::steady_clock;
   const auto wall0 = clock::now();
@@ -259,7 +263,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
     // An implicit stage may have taken a shorter step than asked (a retry at half the step).
     const bool shortened = c_.dt < dt;
     dt = c_.dt;
-    c_.time = (steps == 1.0 && !shortened) ? t_end : c_.time + dt;
+    c_.time = step_end_time(c_.time, dt, t_end, steps == 1.0 && !shortened);
     fs.substeps++;
     fs.dt_min = std::min(fs.dt_min, dt);
     fs.dt_max = std::max(fs.dt_max, dt);

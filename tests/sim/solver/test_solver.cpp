@@ -62,6 +62,25 @@ TEST_CASE("a block in free fall follows x0 + v0 t + g t^2 / 2", "[solver]") {
   }
 }
 
+TEST_CASE("substeps end on the frame's end, not a round-off before it", "[solver]") {
+  // Eleven equal steps of a 1/12 s frame sum to 1.4e-17 s short of it: without the snap a
+  // twelfth step of that length would follow.
+  const double t_end = 1.0 / 12, dt = t_end / 11;
+  double t = 0, naive = 0;
+  int steps = 0;
+  while (t < t_end && steps < 20) {
+    t = step_end_time(t, dt, t_end, false);
+    naive += dt;
+    ++steps;
+  }
+  CHECK(naive < t_end);  // the sum alone falls short
+  CHECK(steps == 11);
+  CHECK(t == t_end);
+  // A step that is really short of the end stays short.
+  CHECK(step_end_time(0, 0.5 * t_end, t_end, false) == 0.5 * t_end);
+  CHECK(step_end_time(0.25, 0.5, 1.0, true) == 1.0);
+}
+
 TEST_CASE("a falling block stops on a ground plane collider", "[solver][collider]") {
   Scene s = block_scene();
   ColliderDesc ground;
