@@ -142,6 +142,9 @@ std::vector<KeySpec> build_schema() {
           .ge(0.5)
           .le(1),
       Spec("shot.plasticity_in_solve", T::Bool).to(&ShotSettings::plasticity_in_solve).def("false"),
+      Spec("shot.shell_fields_in_solve", T::Bool)
+          .to(&ShotSettings::shell_fields_in_solve)
+          .def("false"),
       Spec("shot.units", T::String).to(&ShotSettings::units).def("m").nonempty(),
       Spec("shot.on_integrity_failure", T::Enum)
           .to(&ShotSettings::on_integrity_failure)

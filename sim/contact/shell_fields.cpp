@@ -348,7 +348,7 @@ Real ShellFields::shell_gap(const Body& A, const Body& B, Real h) const {
   return h * dx_ - (half_thickness_[A.shell] + half_thickness_[B.shell]);
 }
 
-bool ShellFields::shell_pairs(std::vector<Body>& bodies) const {
+bool ShellFields::shell_pairs(std::vector<Body>& bodies, Union* groups) const {
   bool acted = false;
   const std::size_t cnt = bodies.size();
   for (std::size_t i = 0; i < cnt; ++i)
@@ -383,15 +383,16 @@ bool ShellFields::shell_pairs(std::vector<Body>& bodies) const {
         continue;
       }
       const Real gap = shell_gap(A, B, h);
-      const bool met = field_contact(nab, std::sqrt(friction_[A.shell] * friction_[B.shell]),
-                                     A.winv, A.vel, B.winv, B.vel, closing_allowance(gap, dt_)) ||
-                       gap <= 0;
-      acted |= met;
+      const bool ruled = field_contact(nab, std::sqrt(friction_[A.shell] * friction_[B.shell]),
+                                       A.winv, A.vel, B.winv, B.vel, closing_allowance(gap, dt_));
+      if ((ruled || gap <= 0) && groups) groups->join(int(i), int(j));
+      acted |= ruled || gap <= 0;
     }
   return acted;
 }
 
-bool ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk) const {
+bool ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk,
+                             Union* groups) const {
   // Which side of a shell the bulk material is on: where its mass centroid lies
   // along the shell's own normal (Nairn's multi-material contact takes the
   // normal from the mass distribution the same way). The node's side is not
@@ -411,7 +412,9 @@ bool ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real m
   const Real s =
       have_ok && surfaces_ ? surface_distance_from_share(bm->m / (dx_ * dx_ * dx_)) : Real(0);
   bool acted = false;
-  for (Body& B : bodies) {
+  const int bulk = int(bodies.size());
+  for (int i = 0; i < bulk; ++i) {
+    Body& B = bodies[std::size_t(i)];
     Vec3 nb = B.nrm;
     if (have_ok && B.own.squaredNorm() > 0) {
       const Real d = B.own.dot(ok - B.off);
@@ -422,10 +425,10 @@ bool ShellFields::bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real m
     // beyond the node, the material's surface s cells before it.
     const Real gap = surfaces_ && have_ok ? (s - nb.dot(B.off)) * dx_ - half_thickness_[B.shell]
                                           : -std::numeric_limits<Real>::infinity();
-    const bool met = field_contact(nb, friction_[B.shell], B.winv, B.vel, Real(1) / mk, vk,
-                                   closing_allowance(gap, dt_)) ||
-                     gap <= 0;
-    acted |= met;
+    const bool ruled = field_contact(nb, friction_[B.shell], B.winv, B.vel, Real(1) / mk, vk,
+                                     closing_allowance(gap, dt_));
+    if ((ruled || gap <= 0) && groups) groups->join(i, bulk);
+    acted |= ruled || gap <= 0;
   }
   return acted;
 }
@@ -446,8 +449,18 @@ void ShellFields::resolve_node(const GridNode& cn, std::size_t g, int n, bool mo
   for (Body& B : bodies) body_geometry(B);
   // Shell against shell (facing across the node, or stacked on one side of it),
   // then each shell against the bulk field: Bardenhagen's rule.
-  bool met = shell_pairs(bodies);
-  if (bulk) met |= bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk);
+  Union groups(int(cnt) + 1);
+  Union* uf = implicit_ ? &groups : nullptr;
+  bool met = shell_pairs(bodies, uf);
+  if (bulk) met |= bulk_pairs(bodies, moments ? &bulk_mom_[g][n] : nullptr, mk, vk, uf);
+  if (uf) {
+    // Each body's group as the index of its first body, 4 bits a body; more bodies than
+    // fit: one group (zero).
+    std::uint64_t code = 0;
+    if (cnt + 1 <= std::size_t(kMaxGroupBodies))
+      for (std::size_t i = 0; i <= cnt; ++i) code |= std::uint64_t(groups.find(int(i))) << (4 * i);
+    group_[g][n] = code;
+  }
   for (const Body& B : bodies) *B.r = B.vel - v0;
   if (met) met_[g] |= std::uint64_t(1) << n;
   if (bulk) r_bulk_[g][n] = vk - v0;
@@ -476,6 +489,9 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   met_.assign(ng, 0);
   dt_ = dt;
   dx_ = static_cast<Real>(combined.dx());
+  slotted_ = false;
+  slot_bits_.assign(ng, 0);
+  if (implicit_) group_.resize(ng);
   const bool moments = bulk_particles && bulk_particles->size() > 0;
   if (moments) bulk_moments(combined, *bulk_particles, first_bulk, serial);
   parallel_for(
@@ -606,6 +622,7 @@ void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool seri
         const Vec3i c = unpack_block(combined.gblock_key[g]) * kBlockSize;
         for (int n = 0; n < kBlockNodes; ++n) {
           if (!(shared_[g] >> n & 1)) continue;
+          if (slot_bits_[g] >> n & 1) continue;  // the implicit solve moved its bodies
           const Vec3i node = c + Vec3i(n >> 4, (n >> 2) & 3, n & 3);
           const bool one = skip && skip(node);
           if (!one && gate && gate->engaged(g, n)) {
@@ -632,62 +649,65 @@ void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool seri
       serial);
 }
 
+void ShellFields::each_relative(const Field& F, bool serial, const RelativeFn& fn) const {
+  const bool folded = !F.folds.empty();
+  if (heights_only_ && !folded) return;  // relative velocities exist on fold blocks only
+  parallel_for_each(
+      F.grid.num_particle_blocks(), 1,
+      [&](std::size_t b) {
+        const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
+        const auto& nbr = F.grid.pblock_nbr[b];
+        // Heights only: relative velocities exist on fold blocks only.
+        if (heights_only_ &&
+            std::none_of(nbr.begin(), nbr.end(), [&](int g) { return g >= 0 && F.fold[g] >= 0; }))
+          return;
+        for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
+          const std::uint32_t j = F.grid.order()[q];
+          const QuadraticWeights W(F.grid.grid_coord(F.x0[j]));
+          const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
+          Vec3 dv = Vec3::Zero();
+          Mat3 B = Mat3::Zero();
+          bool any = false;
+          for_each_stencil_node(W, bc, [&](const StencilNode& n) {
+            const int o = (n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2);
+            const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
+            const int fi = folded ? F.fold[nbr[o]] : -1;
+            // Where the shell folds, the control point reads its own class.
+            const bool second = fi >= 0 && is_split(F.folds[fi], bn) &&
+                                fold_height(F.normal[j], fx, n.i, n.j, n.k) >= F.folds[fi].cut[bn];
+            // Heights only: F.r is kept on fold blocks alone, zero elsewhere.
+            if (heights_only_ && fi < 0) return;
+            const Vec3& rn = second ? F.folds[fi].r[bn] : F.r[nbr[o]][bn];
+            if (rn.isZero()) return;
+            any = true;
+            dv += n.w * rn;
+            B += (n.w * rn) * (Vec3(Real(n.i), Real(n.j), Real(n.k)) - fx).transpose();
+          });
+          if (any) fn(j, dv, B);
+        }
+      },
+      serial);
+}
+
 void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial) {
-  const std::size_t K = fields_.size();
   // Control points read their shell's relative velocity.
-  for (std::size_t s = 0; s < K; ++s) {
-    Field& F = fields_[s];
+  for (std::size_t s = 0; s < fields_.size(); ++s) {
     GridShell& gs = shells[s];
     ShellObject& sh = *gs.shell;
-    const Real c_scale = Real(4) / static_cast<Real>(F.grid.dx());
-    const bool folded = !F.folds.empty();
-    if (heights_only_ && !folded) continue;  // relative velocities exist on fold blocks only
-    parallel_for_each(
-        F.grid.num_particle_blocks(), 1,
-        [&](std::size_t b) {
-          const Vec3i bc = unpack_block(F.grid.pblock_key[b]) * kBlockSize;
-          const auto& nbr = F.grid.pblock_nbr[b];
-          // Heights only: relative velocities exist on fold blocks only.
-          if (heights_only_ &&
-              std::none_of(nbr.begin(), nbr.end(), [&](int g) { return g >= 0 && F.fold[g] >= 0; }))
-            return;
-          for (std::uint32_t q = F.grid.pblock_start[b]; q < F.grid.pblock_start[b + 1]; ++q) {
-            const std::uint32_t j = F.grid.order()[q];
-            const QuadraticWeights W(F.grid.grid_coord(F.x0[j]));
-            const Vec3 fx(W.fx[0], W.fx[1], W.fx[2]);
-            Vec3 dv = Vec3::Zero();
-            Mat3 B = Mat3::Zero();
-            bool any = false;
-            for_each_stencil_node(W, bc, [&](const StencilNode& n) {
-              const int o = (n.px >> 2) * 4 + (n.py >> 2) * 2 + (n.pz >> 2);
-              const int bn = block_node(n.px & 3, n.py & 3, n.pz & 3);
-              const int fi = folded ? F.fold[nbr[o]] : -1;
-              // Where the shell folds, the control point reads its own class.
-              const bool second =
-                  fi >= 0 && is_split(F.folds[fi], bn) &&
-                  fold_height(F.normal[j], fx, n.i, n.j, n.k) >= F.folds[fi].cut[bn];
-              // Heights only: F.r is kept on fold blocks alone, zero elsewhere.
-              if (heights_only_ && fi < 0) return;
-              const Vec3& rn = second ? F.folds[fi].r[bn] : F.r[nbr[o]][bn];
-              if (rn.isZero()) return;
-              any = true;
-              dv += n.w * rn;
-              B += (n.w * rn) * (Vec3(Real(n.i), Real(n.j), Real(n.k)) - fx).transpose();
-            });
-            if (!any) continue;
-            // Pinned components keep their prescribed velocity, but their affine matrix
-            // still becomes the gradient of this shell's own field: left at the shared
-            // node's, a pinned sheet under a sliding block would carry the block's shear
-            // and the contact would see it moving.
-            const std::uint8_t held = gs.held[j];
-            for (int a = 0; a < 3; ++a)
-              if (held & (1u << a)) dv[a] = 0;
-            sh.v[j] += dv;
-            sh.x[j] += dt * dv;
-            gs.contact->C[j] += c_scale * B;
-          }
-        },
-        serial);
+    const Real c_scale = Real(4) / static_cast<Real>(fields_[s].grid.dx());
+    each_relative(fields_[s], serial, [&](std::uint32_t j, const Vec3& sum, const Mat3& B) {
+      Vec3 dv = sum;
+      // Pinned components keep their prescribed velocity, but their affine matrix still
+      // becomes the gradient of this shell's own field: left at the shared node's, a
+      // pinned sheet under a sliding block would carry the block's shear and the contact
+      // would see it moving.
+      const std::uint8_t held = gs.held[j];
+      for (int a = 0; a < 3; ++a)
+        if (held & (1u << a)) dv[a] = 0;
+      sh.v[j] += dv;
+      sh.x[j] += dt * dv;
+      gs.contact->C[j] += c_scale * B;
+    });
   }
 }
 

@@ -32,14 +32,17 @@
 // where the bulk share is too small to separate from round-off (under 1e-3 of the mass),
 // keep one velocity.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <utility>
 #include <vector>
 
+#include "sim/contact/field_slots.h"
 #include "sim/contact/shell_transfer.h"
 #include "sim/core/types.h"
 #include "sim/mpm/particles.h"
@@ -124,6 +127,30 @@ class ShellFields {
   /// matching APIC term, r its shell's velocity relative to the node's (held components
   /// unchanged).
   void after_g2p(std::vector<GridShell>& shells, Real dt, bool serial);
+
+  /// The implicit grid step (field_slots.h). p2g then records which bodies Bardenhagen's
+  /// rule brought together at each node.
+  void set_implicit(bool on) { implicit_ = on; }
+  /// Before the solve (once a step, after p2g): the groups' unknowns and offsets at the
+  /// shared nodes that skip() and the gate leave to the fields (the gate's colliders posed
+  /// for the step).
+  void slots(const SparseGrid& combined, const std::vector<GridShell>& shells, const SkipFn& skip,
+             const ColliderGate* gate, FieldSlots& out, bool serial);
+  bool has_slots() const { return slotted_; }
+  /// After the solve (the combined grid holds its node velocities u): each shell's velocity
+  /// at the slotted nodes, relative to u, from its group's unknown (slot_vel per slot).
+  /// before_g2p leaves those nodes as they are.
+  void take_solution(const SparseGrid& combined, const FieldSlots& fs,
+                     const std::vector<Vec3>& slot_vel, bool serial);
+  /// After a solve (the combined grid holds its node velocities; `before`: its nodes as
+  /// P2G left them): the rule again on the solved velocities at the slotted nodes. Where
+  /// two groups close on each other faster than their gap allows, they are joined, with
+  /// the rule's outcome on the solved velocities as the offsets, and true is returned:
+  /// restore the grid, call slots() again and solve again (an active set: bodies apart
+  /// when the step began, that the step's forces drive together, meet inside it).
+  bool regroup(const SparseGrid& combined,
+               const std::vector<std::array<GridNode, kBlockNodes>>& before,
+               const std::vector<Vec3>& slot_vel);
 
  private:
   struct Node {
@@ -282,6 +309,25 @@ class ShellFields {
     Vec3 vel, nrm, own, off;  ///< velocity, normal to the node, own normal, centroid
     Real winv;                ///< inverse effective mass (pinned share: infinite)
   };
+  /// The rule's groups at a node (implicit_): 4 bits per body in node_bodies' order, the
+  /// bulk field last, each the index of its group's first body; all zero: one group.
+  static constexpr int kMaxGroupBodies = 16;
+  struct Union {
+    std::uint8_t up[kMaxGroupBodies];
+    explicit Union(int n) {
+      for (int i = 0; i < n && i < kMaxGroupBodies; ++i) up[i] = std::uint8_t(i);
+    }
+    int find(int i) const {
+      while (up[i] != i) i = up[i];
+      return i;
+    }
+    void join(int a, int b) {
+      if (a >= kMaxGroupBodies || b >= kMaxGroupBodies) return;
+      a = find(a);
+      b = find(b);
+      if (a != b) up[std::max(a, b)] = std::uint8_t(std::min(a, b));
+    }
+  };
   // Steps of p2g().
   /// fblock_, fielded_: each field's block at each combined grid block.
   void find_field_blocks(const SparseGrid& combined, bool serial);
@@ -300,10 +346,11 @@ class ShellFields {
   static Vec3 contact_normal(const Body& A, const Body& B, Real sign);
   /// Shell against shell at one node (facing across it, or stacked on one side); returns
   /// whether the rule acted on a pair.
-  bool shell_pairs(std::vector<Body>& bodies) const;
+  bool shell_pairs(std::vector<Body>& bodies, Union* groups) const;
   /// Each shell against the bulk field (mass mk, velocity vk; bm its centroid and volume
   /// sum, or null); returns whether the rule acted on a pair.
-  bool bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk) const;
+  bool bulk_pairs(std::vector<Body>& bodies, const Moment* bm, Real mk, Vec3& vk,
+                  Union* groups) const;
   /// The gap [m] between shells a and b at a node whose centroids lie h cells apart along
   /// the normal from a to b; -inf where contact is at the stencils.
   Real shell_gap(const Body& A, const Body& B, Real h) const;
@@ -345,6 +392,19 @@ class ShellFields {
   /// combined grid block with shared nodes: free_[free_slot_[g]].
   std::vector<int> free_slot_;
   std::vector<std::array<Vec3, kBlockNodes>> free_;
+  /// Calls fn(j, dv, B) for each control point j of field F whose stencil holds relative
+  /// velocities: dv = sum w r, B = sum w r (x_n - x_j)^T / dx (in cells).
+  using RelativeFn = std::function<void(std::uint32_t, const Vec3&, const Mat3&)>;
+  void each_relative(const Field& F, bool serial, const RelativeFn& fn) const;
+  bool implicit_ = false;
+  bool slotted_ = false;                                       ///< slots() ran since the last p2g
+  std::vector<std::array<std::uint64_t, kBlockNodes>> group_;  ///< per combined grid block
+  std::vector<std::uint64_t> slot_bits_;  ///< per combined grid block: slotted nodes
+  /// The relative velocities of the bodies in slots, and their slot (take_solution).
+  std::vector<std::pair<Vec3*, int>> slot_r_;
+  /// The groups of the bodies at a slotted node, as slots() reads them: the rule's (code),
+  /// a shell's fold classes together, a sliver of bulk in the base group.
+  static Union node_groups(std::uint64_t code, const std::vector<Body>& bodies, bool bulk);
   /// Node n of combined grid block g under a collider gate: each body keeps its own
   /// velocity, with the collider's condition applied to it where it is near the collider.
   void gate_collider_node(GridNode& nd, std::size_t g, int n, const Vec3& node_pos,

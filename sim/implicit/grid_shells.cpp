@@ -151,9 +151,14 @@ void GridShellTerms::move(const std::vector<PadD>& vel) {
           const std::uint32_t j = table_.local(g);
           const QuadraticWeights W(grid_.grid_coord(S.gs->shell->x[j]));
           Vec3d v = Vec3d::Zero();
+          const std::size_t s = table_.shell(g);
+          const bool slotted = slots_ && !slots_->slot_of[s].empty();
           for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
-            v += static_cast<double>(nd.w) * vel[b][nd.pad()];
+            const int k = slotted ? slot_at(s, node_of(grid_, b, nd.px, nd.py, nd.pz)) : -1;
+            v += static_cast<double>(nd.w) *
+                 (k >= 0 ? (*slot_vel_)[std::size_t(k)] : vel[b][nd.pad()]);
           });
+          if (slots_) v += slots_->control[s][j].cast<double>();
           for (int a = 0; a < 3; ++a)
             if (S.held[j] & (1u << a)) {
               S.X[j][a] = S.target[j][a];
@@ -252,23 +257,34 @@ double GridShellTerms::energy(const std::vector<PadD>& vel) {
   return evaluate(false);
 }
 
-double GridShellTerms::gradient(const std::vector<PadD>& vel, std::vector<PadD>& grad) {
+double GridShellTerms::gradient(const std::vector<PadD>& vel, std::vector<PadD>& grad,
+                                std::vector<Vec3d>* slot_grad) {
   move(vel);
   advance_sites(vel);
   const double e = evaluate(true);
   const std::uint32_t nc = table_.num_control_points();
+  // The slots' parts per particle block, summed in block order after (the same sums for
+  // any thread count).
+  std::vector<std::vector<std::pair<int, Vec3d>>> slot_parts(slots_ ? grid_.num_particle_blocks()
+                                                                    : 0);
   parallel_for_each(
       grid_.num_particle_blocks(), 1,
       [&](std::size_t b) {
         const Vec3i bc = corner_of(grid_, b);
         each_shell_point(grid_, b, static_cast<std::uint32_t>(table_.size()), [&](std::uint32_t g) {
           if (g < nc) {
-            const Shell& S = sh_[table_.shell(g)];
+            const std::size_t s = table_.shell(g);
+            const Shell& S = sh_[s];
             const std::uint32_t j = table_.local(g);
             const Vec3d d = dt_ * S.dX[j];
             const QuadraticWeights W(grid_.grid_coord(S.gs->shell->x[j]));
+            const bool slotted = slots_ && !slots_->slot_of[s].empty();
             for_each_stencil_node(W, bc, [&](const StencilNode& nd) {
-              grad[b][nd.pad()] += static_cast<double>(nd.w) * d;
+              const int k = slotted ? slot_at(s, node_of(grid_, b, nd.px, nd.py, nd.pz)) : -1;
+              if (k >= 0)
+                slot_parts[b].emplace_back(k, static_cast<double>(nd.w) * d);
+              else
+                grad[b][nd.pad()] += static_cast<double>(nd.w) * d;
             });
             return;
           }
@@ -281,6 +297,9 @@ double GridShellTerms::gradient(const std::vector<PadD>& vel, std::vector<PadD>&
         });
       },
       serial_);
+  if (slot_grad)
+    for (const auto& parts : slot_parts)
+      for (const auto& [k, v] : parts) (*slot_grad)[std::size_t(k)] += v;
   return e;
 }
 
@@ -313,11 +332,12 @@ void GridShellTerms::joint(const std::vector<PadD>& vel, Eigen::Index N, SparseM
       if (g < nc) {
         const QuadraticWeights Wq(grid_.grid_coord(sh_[s].gs->shell->x[j]));
         for_each_stencil_node(Wq, bc, [&](const StencilNode& nd) {
-          const auto node = static_cast<Eigen::Index>(node_of(grid_, b, nd.px, nd.py, nd.pz));
+          const std::size_t node = node_of(grid_, b, nd.px, nd.py, nd.pz);
+          const int k = slot_at(s, node);
+          const Eigen::Index col = k >= 0 ? slot_dof(k) : 3 * static_cast<Eigen::Index>(node);
           for (int a = 0; a < 3; ++a) {
             const int d = dof_of[s][3 * j + a];
-            if (d >= 0)
-              tj.emplace_back(first[s] + d, 3 * node + a, dt_ * static_cast<double>(nd.w));
+            if (d >= 0) tj.emplace_back(first[s] + d, col + a, dt_ * static_cast<double>(nd.w));
           }
         });
         return;

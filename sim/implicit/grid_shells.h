@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "sim/collider/collider.h"
+#include "sim/contact/field_slots.h"
 #include "sim/contact/shell_transfer.h"
 #include "sim/implicit/collider_penalty.h"
 #include "sim/implicit/newton.h"
@@ -66,13 +67,22 @@ class GridShellTerms {
   /// the stiff sheet lag behind a ball pressing into it (2.5 mm of a 3 cm press at 1e-4 s),
   /// which the explicit path's per-step projection of the control points does not allow.
   void set_colliders(const std::vector<Collider>* colliders) { colliders_ = colliders; }
+  /// The shells' own velocities at shared nodes (field_slots.h; null: none): a control
+  /// point reads slot k's velocity (*slot_vel)[k] at a node of slot_of, and adds its
+  /// offset. The objective's unknowns are then the nodes' 3 N_nodes components followed by
+  /// the slots' (vel holds the nodes').
+  void set_slots(const FieldSlots* fs, const std::vector<Vec3d>* slot_vel) {
+    slots_ = fs;
+    slot_vel_ = slot_vel;
+  }
   /// The joint size up to which prepare couples exactly (kExactCouplingLimit; 0: never).
   void set_exact_limit(int m) { exact_limit_ = m; }
   /// E_shells at the node velocities in the particle blocks' padded buffers.
   double energy(const std::vector<PadD>& vel);
   /// Adds dE_shells/du to the particle blocks' padded buffers (summed per node by the
-  /// caller); returns E_shells.
-  double gradient(const std::vector<PadD>& vel, std::vector<PadD>& grad);
+  /// caller), and with slots dE_shells/dU per slot to slot_grad; returns E_shells.
+  double gradient(const std::vector<PadD>& vel, std::vector<PadD>& grad,
+                  std::vector<Vec3d>* slot_grad = nullptr);
 
   /// The preconditioner's shell part at vel (objective dofs 3 (g kBlockNodes + n) + a;
   /// minv: the inverse of the rest of the objective's Hessian, the nodes' mass and bulk
@@ -144,6 +154,17 @@ class GridShellTerms {
   const SparseGrid& grid_;
   const ShellPointTable& table_;
   const std::vector<Collider>* colliders_ = nullptr;
+  const FieldSlots* slots_ = nullptr;
+  const std::vector<Vec3d>* slot_vel_ = nullptr;
+  /// Slot k of shell s at global node `node`, or -1.
+  int slot_at(std::size_t s, std::size_t node) const {
+    if (!slots_ || slots_->slot_of[s].empty()) return -1;
+    return slots_->slot_of[s][node];
+  }
+  /// The objective's index of slot k's first component.
+  Eigen::Index slot_dof(int k) const {
+    return 3 * static_cast<Eigen::Index>(grid_.num_grid_blocks() * kBlockNodes + std::size_t(k));
+  }
   double dt_;
   bool serial_;
   std::vector<Shell> sh_;

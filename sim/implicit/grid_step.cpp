@@ -26,15 +26,23 @@ class GridObjective final : public ImplicitObjective {
   GridObjective(const GridStepInput& in, double dt) : in_(in), grid_(*in.grid), dt_(dt) {
     nb_ = grid_.num_grid_blocks();
     const std::size_t nodes = nb_ * kBlockNodes;
-    m_.setZero(static_cast<Eigen::Index>(nodes));
+    const std::size_t slots = in.slots ? in.slots->num_slots() : 0;
+    nodes_ = nodes;
+    const std::size_t all = nodes + slots;
+    m_.setZero(static_cast<Eigen::Index>(all));
     vhat_.setZero(3 * m_.size());
-    fixed_.assign(3 * nodes, 1);
-    normal_.assign(nodes, Vec3d::Zero());
-    collider_of_.assign(nodes, -1);
-    position_.assign(nodes, Vec3d::Zero());
+    fixed_.assign(3 * all, 1);
+    normal_.assign(all, Vec3d::Zero());
+    collider_of_.assign(all, -1);
+    position_.assign(all, Vec3d::Zero());
     u0_.setZero(3 * m_.size());
     vbuf_.resize(grid_.num_particle_blocks());
     fbuf_.resize(grid_.num_particle_blocks());
+    // Where the shells keep fields of their own, the bulk field's group stands for the node.
+    std::vector<int> base(in.slots ? nodes : 0, -1);
+    if (in.slots)
+      for (std::size_t k = 0; k < in.slots->base_node.size(); ++k)
+        base[in.slots->base_node[k]] = static_cast<int>(k);
     for (std::size_t g = 0; g < nb_; ++g) {
       const Vec3i corner = unpack_block(grid_.gblock_key[g]) * kBlockSize;
       for (int n = 0; n < kBlockNodes; ++n) {
@@ -47,20 +55,39 @@ class GridObjective final : public ImplicitObjective {
           vhat_[3 * i + a] = static_cast<double>(nd.v[a]) / m;  // p / m, in double
           fixed_[3 * i + a] = 0;
         }
+        if (!base.empty() && base[i] >= 0) {
+          const auto k = static_cast<std::size_t>(base[i]);
+          m_[i] = static_cast<double>(in.slots->base_m[k]);
+          vhat_.segment<3>(3 * i) = in.slots->base_v[k].cast<double>();
+        }
         const Vec3i c(corner[0] + n / 16, corner[1] + (n / 4) % 4, corner[2] + n % 4);
         constrain(i, c);
       }
     }
+    for (std::size_t k = 0; k < slots; ++k) {
+      const std::size_t i = nodes + k;
+      m_[static_cast<Eigen::Index>(i)] = static_cast<double>(in.slots->slot_m[k]);
+      vhat_.segment<3>(3 * i) = in.slots->slot_v[k].cast<double>();
+      u0_.segment<3>(3 * i) = vhat_.segment<3>(3 * i) + dt_ * in_.gravity;
+      for (int a = 0; a < 3; ++a) fixed_[3 * i + a] = 0;
+    }
+    slot_vel_.assign(slots, Vec3d::Zero());
+    slot_grad_.assign(slots, Vec3d::Zero());
+    if (in.shells && in.slots) in.shells->set_slots(in.slots, &slot_vel_);
     prepare_diagonal();
   }
 
   Eigen::Index size() const override { return vhat_.size(); }
+  /// Slot k's velocity in u.
+  Vec3d slot_velocity(const VecXd& u, std::size_t k) const {
+    return u.segment<3>(3 * static_cast<Eigen::Index>(nodes_ + k));
+  }
   const VecXd& initial() const { return u0_; }
 
   double energy(const VecXd& u) override {
     scatter(u);
     double e = elastic(nullptr);
-    if (in_.shells) e += in_.shells->energy(vbuf_);
+    if (in_.shells) e += in_.shells->energy(vbuf_);  // slot_vel_ from scatter
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
       if (!(m_[i] > 0)) continue;
       const Vec3d du = u.segment<3>(3 * i) - vhat_.segment<3>(3 * i);
@@ -105,9 +132,12 @@ class GridObjective final : public ImplicitObjective {
   void raw_gradient(const VecXd& u, VecXd& g) {
     scatter(u);
     elastic(&fbuf_);
-    if (in_.shells) in_.shells->gradient(vbuf_, fbuf_);
+    std::fill(slot_grad_.begin(), slot_grad_.end(), Vec3d::Zero());
+    if (in_.shells) in_.shells->gradient(vbuf_, fbuf_, &slot_grad_);
     g.setZero(size());
     gather(fbuf_, g);
+    for (std::size_t k = 0; k < slot_grad_.size(); ++k)
+      g.segment<3>(3 * static_cast<Eigen::Index>(nodes_ + k)) += slot_grad_[k];
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
       if (!(m_[i] > 0)) continue;
       g.segment<3>(3 * i) +=
@@ -219,8 +249,10 @@ class GridObjective final : public ImplicitObjective {
     u0_.segment<3>(3 * i) = v;
   }
 
-  /// u into every particle block's padded buffer (vbuf_).
+  /// The nodes' part of u into every particle block's padded buffer (vbuf_), the slots'
+  /// into slot_vel_.
   void scatter(const VecXd& u) {
+    for (std::size_t k = 0; k < slot_vel_.size(); ++k) slot_vel_[k] = slot_velocity(u, k);
     parallel_for_each(
         grid_.num_particle_blocks(), 4,
         [&](std::size_t b) {
@@ -374,6 +406,9 @@ class GridObjective final : public ImplicitObjective {
   SparseGrid& grid_;
   double dt_;
   std::size_t nb_ = 0;
+  std::size_t nodes_ = 0;        ///< grid nodes; slot k's unknowns follow at 3 (nodes_ + k)
+  std::vector<Vec3d> slot_vel_;  ///< the slots' velocities at the last scatter
+  std::vector<Vec3d> slot_grad_;
   VecXd m_, vhat_, u0_, diag_, base_diag_;
   SparseMatrixD minv_;         // the diagonal's inverse on the constrained subspace (3x3 blocks)
   bool shells_ready_ = false;  // the shells' preconditioner is prepared
@@ -398,6 +433,11 @@ NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const Newton
   NewtonReport rep = newton_minimise(obj, u, opt);
   if (!rep.converged) return rep;
   obj.apply_friction(u);
+  if (in.slot_out) {
+    const std::size_t ns = in.slots ? in.slots->num_slots() : 0;
+    in.slot_out->resize(ns);
+    for (std::size_t k = 0; k < ns; ++k) (*in.slot_out)[k] = obj.slot_velocity(u, k).cast<Real>();
+  }
   SparseGrid& grid = *in.grid;
   for (std::size_t g = 0; g < grid.num_grid_blocks(); ++g)
     for (int n = 0; n < kBlockNodes; ++n) {

@@ -58,6 +58,12 @@ struct GridStepInput {
   /// q as first_bulk + q); null: none.
   GridShellTerms* shells = nullptr;
   std::uint32_t first_bulk = 0;
+  /// The shells' own velocities at shared nodes (field_slots.h; null: none): their groups'
+  /// masses and velocities replace the nodes' where the bulk field's group has them, and
+  /// each slot adds three unknowns after the nodes'. On convergence slot_out gets the
+  /// slots' velocities.
+  const FieldSlots* slots = nullptr;
+  std::vector<Vec3>* slot_out = nullptr;
   /// With shells: `factorised` factorises the tangent on the nodes the shells reach
   /// (Jacobi elsewhere); `block_jacobi` keeps its diagonal.
   bool factorise = true;

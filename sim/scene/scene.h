@@ -85,6 +85,9 @@ struct ShotSettings {
   /// mapping's incremental potential: the solve sees the returned stress), or only after
   /// it (the solve sees the elastic trial stress).
   bool plasticity_in_solve = false;
+  /// Implicit grid step: the shells' own velocity fields at shared nodes as unknowns of
+  /// the solve (field_slots.h), or added after it.
+  bool shell_fields_in_solve = false;
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
   enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;

@@ -97,6 +97,8 @@ void Solver::setup_contact() {
       c_.grid,
       c_.scene.shot.shell_velocities == ShellVelocities::Shared ? 0 : c_.grid_shells.size(),
       !c_.scene.sources.empty(), c_.scene.shot.fold_fields);
+  c_.shell_fields.set_implicit(c_.scene.shot.integrator == Integrator::Implicit &&
+                               c_.scene.shot.shell_fields_in_solve);
   std::vector<Real> half;
   for (const GridShell& g : c_.grid_shells) {
     const ShellMaterialDesc& m = g.shell->material();

@@ -1,5 +1,8 @@
 #include "sim/solver/step_context.h"
 
+#include <algorithm>
+#include <limits>
+
 #include "sim/core/parallel.h"
 
 namespace shellmpm {
@@ -98,6 +101,38 @@ bool StepContext::single_velocity_node(const Vec3i& n) const {
     if (c.apply(at.lo, v)) return true;
   }
   return false;
+}
+
+bool StepContext::shell_field_rule(ShellFields::SkipFn& skip, ShellFields::ColliderGate& gate) {
+  if (!shell_fields.contact_at_surfaces() || colliders.empty()) {
+    skip = [this](const Vec3i& n) { return single_velocity_node(n); };
+    return false;
+  }
+  // Contact at the surfaces: a collider's condition reaches the bodies near it only.
+  skip = [this](const Vec3i& n) { return wall_node(n); };
+  const auto node_at = [this](std::size_t g, int n) -> Vec3i {
+    return unpack_block(grid.gblock_key[g]) * kBlockSize + Vec3i(n >> 4, (n >> 2) & 3, n & 3);
+  };
+  gate.engaged = [this, node_at](std::size_t g, int n) {
+    for (std::size_t k = 0; k < colliders.size(); ++k)
+      if (collider_reach.engaged(g, n, k)) {
+        Vec3 v = Vec3::Zero();
+        if (colliders[k].apply(grid.node_position(node_at(g, n)), v)) return true;
+      }
+    return false;
+  };
+  gate.phi = [this](const Vec3d& x) {
+    double phi = std::numeric_limits<double>::infinity();
+    for (const Collider& col : colliders) phi = std::min(phi, col.phi(x));
+    return phi;
+  };
+  gate.apply = [this, node_at](std::size_t g, int n, Vec3& v) {
+    const Vec3d x = grid.node_position(node_at(g, n));
+    for (std::size_t k = 0; k < colliders.size(); ++k)
+      if (collider_reach.engaged(g, n, k)) colliders[k].apply(x, v);
+  };
+  gate.reach = static_cast<Real>(kColliderReachCells * grid.dx());
+  return true;
 }
 
 void StepContext::add_particles_from(std::size_t i, const std::vector<Vec3d>& pts) {

@@ -110,6 +110,11 @@ struct StepContext {
   bool single_velocity_node(const Vec3i& n) const;
   /// Nodes within kWallCells of the domain's boundary.
   bool wall_node(const Vec3i& n) const;
+  /// How the shells' fields meet the walls and colliders at shared nodes: with contact at
+  /// the surfaces and colliders, a gate (ShellFields::ColliderGate) and the walls as the
+  /// nodes that keep one velocity; else no gate and walls and colliders both keep one.
+  /// Returns whether `gate` was set.
+  bool shell_field_rule(ShellFields::SkipFn& skip, ShellFields::ColliderGate& gate);
   /// Appends bulk particles of source i at positions pts (at rest velocity of the source).
   void add_particles_from(std::size_t source, const std::vector<Vec3d>& pts);
 };

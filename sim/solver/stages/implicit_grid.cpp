@@ -8,6 +8,10 @@
 #include "sim/solver/stages/scene_rules.h"
 
 namespace shellmpm {
+namespace {
+/// Solves again a step at most this often with the groups its solution joined.
+constexpr int kMaxRegroups = 3;
+}  // namespace
 
 bool ImplicitGridStage::needed(const Scene& s) {
   return s.shot.integrator == Integrator::Implicit && grid_needed(s);
@@ -48,12 +52,27 @@ void ImplicitGridStage::run(StepContext& c) {
   double dt = cap_ > 0 ? std::min(c.dt, cap_) : c.dt;
   bool retried = false;
   int iterations = 0;
+  FieldSlots slots;
+  std::vector<Vec3> slot_vel;
+  std::vector<std::array<GridNode, kBlockNodes>> before;  // the grid as P2G left it
+  int regroups = 0;
   while (true) {
     for (Collider& col : c.colliders) col.begin_step(c.time, dt);
     if (!c.colliders.empty()) {
       c.dt = dt;  // the reach's prediction covers the step tried
       c.compute_collider_reach();
       in.reach = &c.collider_reach;
+    }
+    if (shot.shell_fields_in_solve && c.shell_fields.active() && !c.shell_fields.has_slots()) {
+      // The shells' own fields as unknowns of the solve (field_slots.h), their groups from
+      // the rule p2g applied; the walls and the colliders posed for the first step tried.
+      ShellFields::SkipFn skip;
+      ShellFields::ColliderGate gate;
+      const bool gated = c.shell_field_rule(skip, gate);
+      c.shell_fields.slots(c.grid, c.grid_shells, skip, gated ? &gate : nullptr, slots,
+                           c.opt.serial);
+      in.slots = &slots;
+      in.slot_out = &slot_vel;
     }
     std::unique_ptr<GridShellTerms> shells;
     if (!c.grid_shells.empty()) {
@@ -62,9 +81,22 @@ void ImplicitGridStage::run(StepContext& c) {
       shells->set_colliders(&c.colliders);
       in.shells = shells.get();
     }
+    if (in.slots && regroups == 0) before = c.grid.gblock_nodes;
     const NewtonReport rep = implicit_grid_step(in, dt, opt);
     c.implicit_frame.add(rep.iterations, rep.cg_iterations, rep.residual);
     iterations = rep.iterations;
+    if (rep.converged && in.slots && regroups < kMaxRegroups &&
+        c.shell_fields.regroup(c.grid, before, slot_vel)) {
+      // Bodies the step drove together: solved again with them in one group.
+      ++regroups;
+      c.grid.gblock_nodes = before;
+      ShellFields::SkipFn skip;
+      ShellFields::ColliderGate gate;
+      const bool gated = c.shell_field_rule(skip, gate);
+      c.shell_fields.slots(c.grid, c.grid_shells, skip, gated ? &gate : nullptr, slots,
+                           c.opt.serial);
+      continue;
+    }
     if (rep.converged) break;
     retried = true;
     ++c.implicit_frame.retries;
@@ -81,6 +113,7 @@ void ImplicitGridStage::run(StepContext& c) {
       throw SimulationError(os.str());
     }
   }
+  if (in.slots) c.shell_fields.take_solution(c.grid, slots, slot_vel, c.opt.serial);
   if (retried)
     cap_ = dt;
   else if (cap_ > 0 && 3 * iterations <= opt.max_iterations)

@@ -232,6 +232,91 @@ TEST_CASE("implicit grid with shells: the gradient matches finite differences", 
 }
 
 TEST_CASE(
+    "implicit grid with shells: the shell's own velocities at shared nodes are unknowns; "
+    "the gradient matches finite differences",
+    "[implicit]") {
+  // Slots at every other node the sheet's control points reach that the jelly shares: the
+  // sheet's group takes half the node's mass and moves on its own velocity there.
+  Rig rig;
+  const std::size_t nodes = rig.grid.num_grid_blocks() * kBlockNodes;
+  FieldSlots fs;
+  fs.slot_of.assign(1, std::vector<int>(nodes, -1));
+  fs.control.assign(1, std::vector<Vec3>(rig.shell->size(), Vec3(Real(0.01), Real(-0.02), 0)));
+  std::vector<char> reached(nodes, 0);
+  for (std::size_t b = 0; b < rig.grid.num_particle_blocks(); ++b) {
+    const Vec3i bc = unpack_block(rig.grid.pblock_key[b]) * kBlockSize;
+    for (std::uint32_t q = rig.grid.pblock_start[b]; q < rig.grid.pblock_start[b + 1]; ++q) {
+      const std::uint32_t i = rig.grid.order()[q];
+      if (i >= rig.table.num_control_points()) continue;
+      const QuadraticWeights W(rig.grid.grid_coord(rig.shell->x[rig.table.local(i)]));
+      for (int x = 0; x < 3; ++x)
+        for (int y = 0; y < 3; ++y)
+          for (int z = 0; z < 3; ++z) {
+            const Vec3i c = Vec3i(W.base[0] + x, W.base[1] + y, W.base[2] + z) - bc;
+            const int o = (c[0] >= 4 ? 4 : 0) + (c[1] >= 4 ? 2 : 0) + (c[2] >= 4 ? 1 : 0);
+            const int g = rig.grid.pblock_nbr[b][o];
+            reached[std::size_t(g) * kBlockNodes + block_node(c[0] % 4, c[1] % 4, c[2] % 4)] = 1;
+          }
+    }
+  }
+  int every = 0;
+  for (std::size_t i = 0; i < nodes; ++i) {
+    const GridNode& nd = rig.grid.gblock_nodes[i / kBlockNodes][i % kBlockNodes];
+    if (!reached[i] || !(nd.m > 0) || (every++ % 2)) continue;
+    const Vec3 v = Vec3(nd.v[0], nd.v[1], nd.v[2]) / nd.m;
+    fs.base_node.push_back(std::uint32_t(i));
+    fs.base_m.push_back(Real(0.5) * nd.m);
+    fs.base_v.push_back(v);
+    fs.slot_of[0][i] = int(fs.slot_node.size());
+    fs.slot_node.push_back(std::uint32_t(i));
+    fs.slot_m.push_back(Real(0.5) * nd.m);
+    fs.slot_v.push_back(v + Vec3(Real(0.1), 0, Real(-0.05)));
+  }
+  REQUIRE(fs.num_slots() > 10);
+  GridShellTerms terms(rig.grid, rig.table, rig.shells, rig.kls, 0.0, Probe::dt, true);
+  GridStepInput in = rig.input(&terms);
+  in.slots = &fs;
+  VecXd u0;
+  const auto obj = grid_objective(in, Probe::dt, u0);
+  REQUIRE(u0.size() == Eigen::Index(3 * (nodes + fs.num_slots())));
+  // The slots start at their group's velocity plus the step's gravity.
+  CHECK((u0.tail<3>() - (fs.slot_v.back().cast<double>() + Probe::dt * in.gravity)).norm() < 1e-6);
+  VecXd d(u0.size());
+  for (Eigen::Index k = 0; k < d.size(); ++k) d[k] = std::sin(1.7 * k + 0.3);
+  obj->project(d);
+  const VecXd u = u0 + 0.2 * d;
+  VecXd g;
+  obj->gradient(u, g);
+  const double slope = g.dot(d);
+  // The slots' share of the slope: the sheet reads them.
+  VecXd ds = VecXd::Zero(d.size());
+  ds.tail(3 * Eigen::Index(fs.num_slots())) = d.tail(3 * Eigen::Index(fs.num_slots()));
+  const double slot_slope = g.dot(ds);
+  INFO("slope " << slope << ", the slots' " << slot_slope);
+  REQUIRE(std::abs(slot_slope) > 1e-3 * std::abs(slope));
+  for (const VecXd* dir : {&d, &ds}) {
+    const double s0 = g.dot(*dir);
+    double prev = 1e300;
+    for (const double eps : {1e-3, 1e-4, 1e-5}) {
+      const double fd = (obj->energy(u + eps * *dir) - obj->energy(u - eps * *dir)) / (2 * eps);
+      const double err = std::abs(fd - s0);
+      INFO("eps " << eps << " fd " << fd << " analytic " << s0);
+      CHECK(err < 1e-5 * std::abs(s0));
+      CHECK(err <= prev * 1.01 + 1e-9 * std::abs(s0));
+      prev = err;
+    }
+  }
+  // The sheet's terms read the slots: their gradient there is not the mass term's alone.
+  GridStepInput no_shell = in;
+  no_shell.shells = nullptr;
+  VecXd w0, g0;
+  grid_objective(no_shell, Probe::dt, w0)->gradient(u, g0);
+  const Eigen::Index ns = 3 * Eigen::Index(fs.num_slots());
+  INFO("slot gradient " << g.tail(ns).norm() << ", without the sheet " << g0.tail(ns).norm());
+  CHECK((g - g0).tail(ns).norm() > 0.05 * g.tail(ns).norm());
+}
+
+TEST_CASE(
     "implicit grid with shells: with denting inside the solve the gradient matches finite "
     "differences",
     "[implicit]") {
