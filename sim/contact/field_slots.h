@@ -19,7 +19,9 @@
 // M |U - U^*|^2 / 2 with M its bodies' mass and U^* their momentum less their offsets, so the
 // rule's momentum exchange is kept. Bulk material and contact particles read u; a shell's
 // control points read its group's unknown plus its offset. Nodes that keep one velocity
-// (walls, colliders) and nodes under a collider gate keep today's treatment.
+// (walls, colliders) and nodes under a collider gate keep today's treatment. After a solve,
+// groups whose solved velocities close on each other faster than their gap allows are
+// joined and the step is solved again (ShellFields::regroup, up to three times).
 #pragma once
 #include <cstdint>
 #include <vector>
