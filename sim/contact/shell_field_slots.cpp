@@ -5,9 +5,6 @@
 #include "sim/contact/shell_fields.h"
 
 namespace shellmpm {
-namespace {
-constexpr Real kBulkMin = Real(1e-3);  ///< as shell_fields.cpp: bulk share with a field
-}  // namespace
 
 void ShellFields::slots(const SparseGrid& combined, const std::vector<GridShell>& shells,
                         const SkipFn& skip, const ColliderGate* gate, FieldSlots& out,

@@ -13,7 +13,6 @@
 
 namespace shellmpm {
 namespace {
-constexpr Real kBulkMin = Real(1e-3);    ///< bulk share of a node's mass that gets a field
 constexpr Real kShellOnly = Real(1e-4);  ///< below this bulk share the node is shells only
 }  // namespace
 

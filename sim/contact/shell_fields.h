@@ -396,6 +396,8 @@ class ShellFields {
   /// velocities: dv = sum w r, B = sum w r (x_n - x_j)^T / dx (in cells).
   using RelativeFn = std::function<void(std::uint32_t, const Vec3&, const Mat3&)>;
   void each_relative(const Field& F, bool serial, const RelativeFn& fn) const;
+  /// The bulk share of a node's mass that gets a field of its own.
+  static constexpr Real kBulkMin = Real(1e-3);
   bool implicit_ = false;
   bool slotted_ = false;                                       ///< slots() ran since the last p2g
   std::vector<std::array<std::uint64_t, kBlockNodes>> group_;  ///< per combined grid block
