@@ -40,6 +40,9 @@ struct FieldSlots {
   std::vector<std::uint32_t> slot_node;
   std::vector<Real> slot_m;
   std::vector<Vec3> slot_v;
+  /// Per slot, the velocity of its group's first body (the rule's outcome): after a
+  /// regroup, the solved velocity the step's next solve starts from.
+  std::vector<Vec3> slot_start;
   /// Per grid shell: per global node its slot there, -1 for the node's u (empty: the shell
   /// has no slot anywhere).
   std::vector<std::vector<int>> slot_of;

@@ -97,6 +97,7 @@ void ShellFields::slots(const SparseGrid& combined, const std::vector<GridShell>
         out.slot_node.push_back(gi);
         out.slot_m.push_back(M[root]);
         out.slot_v.push_back(P[root] / M[root]);
+        out.slot_start.push_back(post[root]);
       }
       for (std::size_t i = 0; i < nb; ++i) {
         *bodies[i].r = off[i];

@@ -71,6 +71,7 @@ class GridObjective final : public ImplicitObjective {
       u0_.segment<3>(3 * i) = vhat_.segment<3>(3 * i) + dt_ * in_.gravity;
       for (int a = 0; a < 3; ++a) fixed_[3 * i + a] = 0;
     }
+    if (in.start) start_from(*in.start);
     slot_vel_.assign(slots, Vec3d::Zero());
     slot_grad_.assign(slots, Vec3d::Zero());
     if (in.shells && in.slots) in.shells->set_slots(in.slots, &slot_vel_);
@@ -247,6 +248,28 @@ class GridObjective final : public ImplicitObjective {
       }
     }
     u0_.segment<3>(3 * i) = v;
+  }
+
+  /// u0_ moved to a previous solution of the step (GridStepInput::start) within the
+  /// constraints.
+  void start_from(const std::vector<std::array<GridNode, kBlockNodes>>& start) {
+    VecXd d = VecXd::Zero(u0_.size());
+    for (std::size_t g = 0; g < nb_ && g < start.size(); ++g)
+      for (int n = 0; n < kBlockNodes; ++n) {
+        const std::size_t i = g * kBlockNodes + static_cast<std::size_t>(n);
+        if (!(m_[static_cast<Eigen::Index>(i)] > 0)) continue;
+        const Real* v = start[g][static_cast<std::size_t>(n)].v;
+        for (int a = 0; a < 3; ++a)
+          d[static_cast<Eigen::Index>(3 * i) + a] = static_cast<double>(v[a]) - u0_[3 * i + a];
+      }
+    const std::size_t slots = static_cast<std::size_t>(m_.size()) - nodes_;
+    if (in_.slots && in_.slots->slot_start.size() == slots)
+      for (std::size_t k = 0; k < slots; ++k) {
+        const auto i = 3 * static_cast<Eigen::Index>(nodes_ + k);
+        d.segment<3>(i) = in_.slots->slot_start[k].cast<double>() - u0_.segment<3>(i);
+      }
+    project(d);
+    u0_ += d;
   }
 
   /// The nodes' part of u into every particle block's padded buffer (vbuf_), the slots'

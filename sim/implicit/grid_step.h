@@ -64,6 +64,11 @@ struct GridStepInput {
   /// slots' velocities.
   const FieldSlots* slots = nullptr;
   std::vector<Vec3>* slot_out = nullptr;
+  /// A solution of the same step to start Newton from (null: v^n + dt g): the nodes'
+  /// velocities (in v), and the slots' from slots->slot_start; projected onto the
+  /// constraints. The step solved again after its groups were joined (field_slots.h)
+  /// starts where the last solve ended.
+  const std::vector<std::array<GridNode, kBlockNodes>>* start = nullptr;
   /// With shells: `factorised` factorises the tangent on the nodes the shells reach
   /// (Jacobi elsewhere); `block_jacobi` keeps its diagonal.
   bool factorise = true;

@@ -55,6 +55,7 @@ void ImplicitGridStage::run(StepContext& c) {
   FieldSlots slots;
   std::vector<Vec3> slot_vel;
   std::vector<std::array<GridNode, kBlockNodes>> before;  // the grid as P2G left it
+  std::vector<std::array<GridNode, kBlockNodes>> solved;  // the last solve's velocities
   int regroups = 0;
   while (true) {
     for (Collider& col : c.colliders) col.begin_step(c.time, dt);
@@ -89,7 +90,9 @@ void ImplicitGridStage::run(StepContext& c) {
         c.shell_fields.regroup(c.grid, before, slot_vel)) {
       // Bodies the step drove together: solved again with them in one group.
       ++regroups;
+      solved.swap(c.grid.gblock_nodes);
       c.grid.gblock_nodes = before;
+      in.start = &solved;
       ShellFields::SkipFn skip;
       ShellFields::ColliderGate gate;
       const bool gated = c.shell_field_rule(skip, gate);
@@ -98,6 +101,7 @@ void ImplicitGridStage::run(StepContext& c) {
       continue;
     }
     if (rep.converged) break;
+    in.start = nullptr;  // a shorter step starts afresh
     retried = true;
     ++c.implicit_frame.retries;
     dt *= 0.5;
