@@ -57,6 +57,12 @@ void ImplicitGridStage::run(StepContext& c) {
   std::vector<std::array<GridNode, kBlockNodes>> before;  // the grid as P2G left it
   std::vector<std::array<GridNode, kBlockNodes>> solved;  // the last solve's velocities
   int regroups = 0;
+  const auto pose_slots = [&]() {
+    ShellFields::SkipFn skip;
+    ShellFields::ColliderGate gate;
+    const bool gated = c.shell_field_rule(skip, gate);
+    c.shell_fields.slots(c.grid, c.grid_shells, skip, gated ? &gate : nullptr, slots, c.opt.serial);
+  };
   while (true) {
     for (Collider& col : c.colliders) col.begin_step(c.time, dt);
     if (!c.colliders.empty()) {
@@ -67,11 +73,7 @@ void ImplicitGridStage::run(StepContext& c) {
     if (shot.shell_fields_in_solve && c.shell_fields.active() && !c.shell_fields.has_slots()) {
       // The shells' own fields as unknowns of the solve (field_slots.h), their groups from
       // the rule p2g applied; the walls and the colliders posed for the first step tried.
-      ShellFields::SkipFn skip;
-      ShellFields::ColliderGate gate;
-      const bool gated = c.shell_field_rule(skip, gate);
-      c.shell_fields.slots(c.grid, c.grid_shells, skip, gated ? &gate : nullptr, slots,
-                           c.opt.serial);
+      pose_slots();
       in.slots = &slots;
       in.slot_out = &slot_vel;
     }
@@ -93,11 +95,7 @@ void ImplicitGridStage::run(StepContext& c) {
       solved.swap(c.grid.gblock_nodes);
       c.grid.gblock_nodes = before;
       in.start = &solved;
-      ShellFields::SkipFn skip;
-      ShellFields::ColliderGate gate;
-      const bool gated = c.shell_field_rule(skip, gate);
-      c.shell_fields.slots(c.grid, c.grid_shells, skip, gated ? &gate : nullptr, slots,
-                           c.opt.serial);
+      pose_slots();
       continue;
     }
     if (rep.converged) break;
