@@ -100,6 +100,7 @@ void print_time(const Solver& solver, const RunMemory& mem) {
     std::printf("integrator: auto chose %s: %s\n", word_of(s.integrator).c_str(),
                 s.integrator_reason.c_str());
   if (s.integrator == Integrator::Implicit) {
+    if (s.shell_fields_in_solve) std::printf("warning: %s\n", kFieldsInSolveWarning);
     // No wave-speed bound: the step follows motion, the frame and the Newton solves.
     char method[64] = "backward Euler";
     if (s.implicit_theta < 1)

@@ -15,6 +15,12 @@ enum ExitCode : int {
   kExitInternal = 3,    ///< a bug in shellmpm (internal check failed)
 };
 
+/// What `check` and `run` say about shot.shell_fields_in_solve.
+inline constexpr const char* kFieldsInSolveWarning =
+    "shot.shell_fields_in_solve is experimental: on the can on sand at 1/2400 s steps it "
+    "blew up when the plate lifted off (docs/implicit.md); the energy audit reports such a "
+    "frame (stats.json: energy; shot.on_energy_gain: stop ends the run there)";
+
 struct CommonArgs {
   std::string scene;
   std::vector<std::string> overrides;  ///< --set key=value

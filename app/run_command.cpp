@@ -74,6 +74,8 @@ int run_command(const RunArgs& a) {
   if (!scene.shot.integrator_reason.empty())
     progress.message("integrator: auto chose " + word_of(scene.shot.integrator) + ": " +
                      scene.shot.integrator_reason);
+  if (scene.shot.shell_fields_in_solve && scene.shot.integrator == Integrator::Implicit)
+    progress.warning(kFieldsInSolveWarning);
   write_manifest(a, scene);
   std::unique_ptr<PreviewJob> preview;
   if (a.preview || scene.render.preview) preview = make_preview(scene, progress);

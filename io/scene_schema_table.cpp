@@ -149,6 +149,7 @@ std::vector<KeySpec> build_schema() {
       Spec("shot.on_integrity_failure", T::Enum)
           .to(&ShotSettings::on_integrity_failure)
           .def("warn"),
+      Spec("shot.on_energy_gain", T::Enum).to(&ShotSettings::on_energy_gain).def("warn"),
       // materials
       Spec("materials[].name", T::String)
           .to(&MaterialDesc::name)

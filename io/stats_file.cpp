@@ -50,6 +50,29 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     j_im["retries"] = im.retries;
     j["implicit"] = j_im;
   }
+  if (!s.bodies.empty()) {
+    // The energy balance (sim/integrity/energy_audit.h) and each body's energies.
+    const EnergyAudit& a = s.energy;
+    nlohmann::json je;
+    je["judged"] = a.judged;
+    if (!a.reason.empty()) je["not_judged_because"] = a.reason;
+    if (a.judged) {
+      je["start"] = a.start;
+      je["end"] = a.end;
+      je["dissipated"] = a.dissipated;
+      je["supplied"] = a.supplied;
+      je["excess"] = a.excess;
+      je["tolerance"] = a.tolerance;
+      je["ok"] = !a.failed();
+    }
+    nlohmann::json bulk = nlohmann::json::object(), shells = nlohmann::json::object();
+    for (const BodyEnergy& b : s.bodies)
+      (b.shell ? shells : bulk)[b.name] = {
+          {"kinetic", b.kinetic}, {"stored", b.stored}, {"potential", b.potential}};
+    je["materials"] = bulk;
+    if (!shells.empty()) je["shells"] = shells;
+    j["energy"] = je;
+  }
   if (s.integrity.active) {
     const IntegrityReport& r = s.integrity;
     nlohmann::json in;
@@ -85,7 +108,7 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
     for (const IntegrityEvent& e : r.events) {
       static const char* kinds[] = {"bulk_through_shell", "shell_through_shell", "shells_intersect",
                                     "self_intersect",     "inside_collider",     "non_finite",
-                                    "stretched_mesh"};
+                                    "stretched_mesh",     "energy_gain"};
       nlohmann::json je;
       je["kind"] = kinds[static_cast<int>(e.kind)];
       je["object"] = e.object;
@@ -93,6 +116,7 @@ nlohmann::json frame_stats_json(const FrameStats& s) {
       je["count"] = e.count;
       if (e.kind == IntegrityEvent::Kind::InsideCollider) je["depth"] = e.value;
       if (e.kind == IntegrityEvent::Kind::StretchedMesh) je["longest_edge"] = e.value;
+      if (e.kind == IntegrityEvent::Kind::EnergyGain) je["excess"] = e.value;
       je["where"] = {e.where.x(), e.where.y(), e.where.z()};
       ev.push_back(je);
     }

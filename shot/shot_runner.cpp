@@ -215,6 +215,18 @@ void report_integrity(const Scene& scene, const FrameStats& fs, const RunOptions
     stats.write();
     throw SimulationError(lines.front() + " (shot.on_integrity_failure: stop)");
   }
+  if (fs.integrity.energy_gain &&
+      scene.shot.on_energy_gain == ShotSettings::OnEnergyGain::Stop) {
+    stats.add(fs);
+    stats.write();
+    for (const IntegrityEvent& e : fs.integrity.events)
+      if (e.kind == IntegrityEvent::Kind::EnergyGain) {
+        IntegrityReport one;
+        one.events = {e};
+        throw SimulationError(describe_integrity(one, fs.frame, scene.shot.dx).front() +
+                              " (shot.on_energy_gain: stop)");
+      }
+  }
 }
 
 }  // namespace

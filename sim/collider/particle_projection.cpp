@@ -10,9 +10,10 @@ namespace {
 
 constexpr std::size_t kGrain = 4096;
 
-// One point against one collider; returns 1 if moved out from inside, 2 if swept.
+// One point against one collider; returns 1 if moved out from inside, 2 if swept. Adds
+// the velocity change times a moving collider's velocity to wv.
 int project_point(const Collider& c, double dx, double dt, double offset, bool sweep, Vec3& xr,
-                  Vec3& v) {
+                  Vec3& v, double& wv) {
   const Vec3d x = xr.cast<double>();
   const Vec3d start = x - dt * v.cast<double>();
   const Vec3d x0 = c.animated() ? c.end_of(start) : start;  // the start, in the end pose's frame
@@ -27,7 +28,9 @@ int project_point(const Collider& c, double dx, double dt, double offset, bool s
     const Vec3d n = c.normal(x);
     const Vec3d y = x + (1e-4 * dx + offset - phi) * n;
     xr = y.cast<Real>();
+    const Vec3 v0 = v;
     v = c.resolve(y, n, v);
+    if (c.animated()) wv += (v - v0).cast<double>().dot(c.velocity(y));
     return 1;
   }
   const int samples = sweep ? static_cast<int>(std::ceil(len / (0.5 * dx))) : 0;
@@ -39,7 +42,9 @@ int project_point(const Collider& c, double dx, double dt, double offset, bool s
     if (c.phi(y) < offset) {
       const Vec3d n = c.normal(last);
       xr = last.cast<Real>();
+      const Vec3 v0 = v;
       v = c.resolve(last, n, v);
+      if (c.animated()) wv += (v - v0).cast<double>().dot(c.velocity(last));
       return 2;
     }
     last = y;
@@ -52,28 +57,33 @@ int project_point(const Collider& c, double dx, double dt, double offset, bool s
 ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders, double dx,
                                          double dt, std::vector<Vec3>& x, std::vector<Vec3>& v,
                                          const std::vector<std::uint8_t>* held, bool serial,
-                                         double offset) {
+                                         double offset, const ProjectionWork* work) {
   ProjectionStats total;
   if (colliders.empty() || x.empty()) return total;
-  const std::vector<ProjectionStats> part =
-      chunk_parts(x.size(), kGrain, serial, ProjectionStats{},
-                  [&](std::size_t b, std::size_t e, ProjectionStats& st) {
-                    for (std::size_t i = b; i < e; ++i) {
-                      if (held && (*held)[i]) continue;
-                      // The second pass only for points the first one moved.
-                      bool moved = false;
-                      for (int pass = 0; pass < 2 && (pass == 0 || moved); ++pass)
-                        for (const Collider& c : colliders) {
-                          const int r = project_point(c, dx, dt, offset, pass == 0, x[i], v[i]);
-                          st.inside += r == 1;
-                          st.swept += r == 2;
-                          moved = moved || r != 0;
-                        }
-                    }
-                  });
+  const std::vector<ProjectionStats> part = chunk_parts(
+      x.size(), kGrain, serial, ProjectionStats{},
+      [&](std::size_t b, std::size_t e, ProjectionStats& st) {
+        for (std::size_t i = b; i < e; ++i) {
+          if (held && (*held)[i]) continue;
+          // The second pass only for points the first one moved.
+          bool moved = false;
+          double wv = 0;
+          const Vec3d x0 = x[i].cast<double>();
+          for (int pass = 0; pass < 2 && (pass == 0 || moved); ++pass)
+            for (const Collider& c : colliders) {
+              const int r = project_point(c, dx, dt, offset, pass == 0, x[i], v[i], wv);
+              st.inside += r == 1;
+              st.swept += r == 2;
+              moved = moved || r != 0;
+            }
+          if (moved && work)
+            st.work += work->mass(i) * (wv - work->gravity.dot(x[i].cast<double>() - x0));
+        }
+      });
   for (const ProjectionStats& p : part) {
     total.inside += p.inside;
     total.swept += p.swept;
+    total.work += p.work;
   }
   return total;
 }

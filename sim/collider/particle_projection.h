@@ -16,6 +16,7 @@
 // sweep, since the velocity has changed and x - dt v is no longer where the point started.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "sim/collider/collider.h"
@@ -26,16 +27,26 @@ namespace shellmpm {
 struct ProjectionStats {
   std::size_t inside = 0;  ///< points found inside and moved out
   std::size_t swept = 0;   ///< points a collider passed over, moved back
+  /// With ProjectionWork: what the projection supplied [J] (sim/integrity/energy_audit.h):
+  /// each point's impulse m (v' - v) times a moving collider's velocity there (a static
+  /// collider's impulse does no work), plus the potential energy of moving it, -m g . dx.
+  double work = 0;
+};
+
+/// What ProjectionStats::work is measured with.
+struct ProjectionWork {
+  std::function<double(std::size_t i)> mass;  ///< point i's mass [kg]
+  Vec3d gravity{0, 0, 0};                     ///< [m/s^2]
 };
 
 /// Projects points x (velocities v, advected over dt with x += dt v) out of the colliders
 /// (their begin_step set for this step). held: per point, components a pin prescribes
 /// (bit a; may be null): such points are left alone. offset [m]: the points' contact
 /// surface lies that far out from them (half a shell's contact thickness), so they are put
-/// back at phi = offset.
+/// back at phi = offset. work (may be null): measure what the projection supplies.
 ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders, double dx,
                                          double dt, std::vector<Vec3>& x, std::vector<Vec3>& v,
                                          const std::vector<std::uint8_t>* held, bool serial,
-                                         double offset = 0);
+                                         double offset = 0, const ProjectionWork* work = nullptr);
 
 }  // namespace shellmpm

@@ -570,17 +570,28 @@ void ShellFields::keep_free_velocities(const SparseGrid& combined, bool serial) 
       serial);
 }
 
-void ShellFields::gate_collider_node(GridNode& nd, std::size_t g, int n, const Vec3& node_pos,
-                                     const ColliderGate& gate) {
+double ShellFields::gate_collider_node(GridNode& nd, std::size_t g, int n, const Vec3& node_pos,
+                                       const ColliderGate& gate) {
   const std::size_t K = fields_.size();
   const int* fb = fblock_.data() + g * K;
   const Vec3 vf = free_[std::size_t(free_slot_[g])][n];
   const Real dt = dt_;
+  // The work: each body's impulse times the collider's velocity, less the node's own
+  // (counted by the colliders' stage).
+  const Vec3d vc = gate.velocity ? gate.velocity(g, n) : Vec3d::Zero();
+  const bool moving = vc.squaredNorm() > 0;
+  double work = 0;
+  if (moving)
+    work -= double(nd.m) * Vec3d(nd.v[0] - vf[0], nd.v[1] - vf[1], nd.v[2] - vf[2]).dot(vc);
   // A body's velocity, its own (vf + r), meets the collider's condition where its contact
   // surface (at `gap` [m] from the collider) comes within reach in the step.
-  const auto body = [&](Real gap, const Vec3& r) -> Vec3 {
+  const auto body = [&](Real gap, const Vec3& r, Real m) -> Vec3 {
     Vec3 own = vf + r;
-    if (gap <= gate.reach + dt * own.norm()) gate.apply(g, n, own);
+    if (gap <= gate.reach + dt * own.norm()) {
+      const Vec3 before = own;
+      gate.apply(g, n, own);
+      if (moving) work += double(m) * (own - before).cast<double>().dot(vc);
+    }
     return own;
   };
   const auto shell_gap = [&](const Node& f, int s) {
@@ -593,26 +604,28 @@ void ShellFields::gate_collider_node(GridNode& nd, std::size_t g, int n, const V
   if (bulk_at_[g] >> n & 1) {
     const Moment& bm = bulk_mom_[g][n];
     const Real sk = bm.m > 0 ? surface_distance_from_share(bm.m / (dx_ * dx_ * dx_)) : Real(0);
-    node_v = body(Real(gate.phi(node_pos.cast<double>())) + sk * dx_, r_bulk_[g][n]);
+    node_v = body(Real(gate.phi(node_pos.cast<double>())) + sk * dx_, r_bulk_[g][n], bm.m);
   }
   for (std::size_t s = 0; s < K; ++s) {
     if (fb[s] < 0) continue;
     Field& F = fields_[s];
     Node& f = F.nodes[fb[s]][n];
     Vec3& r = F.r[fb[s]][n];
-    if (f.m > 0) r = body(shell_gap(f, int(s)), r) - node_v;
+    if (f.m > 0) r = body(shell_gap(f, int(s)), r, f.m) - node_v;
     const int fi = F.fold[fb[s]];
     if (fi < 0) continue;
     Node& f2 = F.folds[fi].second[n];
     Vec3& r2 = F.folds[fi].r[n];
-    if (f2.m > 0) r2 = body(shell_gap(f2, int(s)), r2) - node_v;
+    if (f2.m > 0) r2 = body(shell_gap(f2, int(s)), r2, f2.m) - node_v;
   }
   for (int a = 0; a < 3; ++a) nd.v[a] = node_v[a];
+  return work;
 }
 
 void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial,
                              const ColliderGate* gate) {
   const std::size_t K = fields_.size();
+  gate_block_work_.assign(gate ? combined.num_grid_blocks() : 0, 0.0);
   parallel_for_each(
       combined.num_grid_blocks(), 4,
       [&](std::size_t g) {
@@ -625,8 +638,9 @@ void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool seri
           const Vec3i node = c + Vec3i(n >> 4, (n >> 2) & 3, n & 3);
           const bool one = skip && skip(node);
           if (!one && gate && gate->engaged(g, n)) {
-            gate_collider_node(combined.gblock_nodes[g][n], g, n,
-                               combined.node_position(node).cast<Real>(), *gate);
+            gate_block_work_[g] +=
+                gate_collider_node(combined.gblock_nodes[g][n], g, n,
+                                   combined.node_position(node).cast<Real>(), *gate);
             continue;
           }
           const Vec3 rk = r_bulk_[g][n];
@@ -646,6 +660,8 @@ void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool seri
         }
       },
       serial);
+  gate_work_ = 0;
+  for (const double w : gate_block_work_) gate_work_ += w;
 }
 
 void ShellFields::each_relative(const Field& F, bool serial, const RelativeFn& fn) const {

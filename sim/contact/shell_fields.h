@@ -112,6 +112,9 @@ class ShellFields {
     /// Applies the conditions of the colliders that node n of block g takes to a body's
     /// velocity v there.
     std::function<void(std::size_t g, int n, Vec3& v)> apply;
+    /// The velocity of the (first) moving collider node n of block g takes [m/s]; zero
+    /// where none moves (the colliders' work, sim/integrity/energy_audit.h).
+    std::function<Vec3d(std::size_t g, int n)> velocity;
     Real reach = 0;  ///< [m]
   };
   /// Before the colliders' conditions (with a gate): keeps the shared nodes' velocities.
@@ -123,6 +126,9 @@ class ShellFields {
   /// each body the collider's velocity or its own (ColliderGate).
   void before_g2p(SparseGrid& combined, const SkipFn& skip, bool serial,
                   const ColliderGate* gate = nullptr);
+  /// The moving colliders' work in the last before_g2p beyond what the colliders' node
+  /// conditions did (each body's impulse under the gate, less the node's) [J].
+  double gate_work() const { return gate_work_; }
   /// After G2P: each control point gets v += sum w r, x += dt sum w r and C += the
   /// matching APIC term, r its shell's velocity relative to the node's (held components
   /// unchanged).
@@ -409,8 +415,11 @@ class ShellFields {
   static Union node_groups(std::uint64_t code, const std::vector<Body>& bodies, bool bulk);
   /// Node n of combined grid block g under a collider gate: each body keeps its own
   /// velocity, with the collider's condition applied to it where it is near the collider.
-  void gate_collider_node(GridNode& nd, std::size_t g, int n, const Vec3& node_pos,
-                          const ColliderGate& gate);
+  /// Returns the colliders' work there beyond the node condition's (gate_work).
+  double gate_collider_node(GridNode& nd, std::size_t g, int n, const Vec3& node_pos,
+                            const ColliderGate& gate);
+  std::vector<double> gate_block_work_;  ///< per combined grid block (before_g2p)
+  double gate_work_ = 0;
 };
 
 }  // namespace shellmpm

@@ -5,7 +5,7 @@
 namespace shellmpm {
 
 double collider_penalty(const ColliderPenaltyInput& in, const std::vector<Vec3d>& X,
-                        std::vector<Vec3d>* grad, std::vector<Mat3d>* K) {
+                        std::vector<Vec3d>* grad, std::vector<Mat3d>* K, double* work) {
   if (K) K->assign(X.size(), Mat3d::Zero());
   if (!in.colliders || in.colliders->empty()) return 0;
   double e = 0;
@@ -25,6 +25,8 @@ double collider_penalty(const ColliderPenaltyInput& in, const std::vector<Vec3d>
       const Vec3d n = col.normal(X[j]);
       if (grad) (*grad)[j] += kappa * phi * n;
       if (K) (*K)[j] += kappa * n * n.transpose();
+      // The impulse over the step, -dt kappa phi n, times the collider's velocity.
+      if (work && col.animated()) *work -= in.dt * kappa * phi * n.dot(col.velocity(X[j]));
     }
   }
   return e;

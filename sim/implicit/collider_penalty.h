@@ -29,8 +29,10 @@ struct ColliderPenaltyInput {
 };
 
 /// The penalty of the control points at X; adds kappa phi n to (*grad)[j] (with grad) and
-/// kappa n n^T to (*K)[j] (with K: resized and zeroed first). Returns its energy [J].
+/// kappa n n^T to (*K)[j] (with K: resized and zeroed first), and the moving colliders'
+/// work over the step, the impulse -dt kappa phi n times their velocity, to *work (with
+/// work). Returns its energy [J].
 double collider_penalty(const ColliderPenaltyInput& in, const std::vector<Vec3d>& X,
-                        std::vector<Vec3d>* grad, std::vector<Mat3d>* K);
+                        std::vector<Vec3d>* grad, std::vector<Mat3d>* K, double* work = nullptr);
 
 }  // namespace shellmpm

@@ -241,14 +241,25 @@ double GridShellTerms::evaluate(bool grad) {
   return e;
 }
 
-double GridShellTerms::collider_penalty(Shell& S, bool grad, std::vector<Mat3d>* K) const {
+ColliderPenaltyInput GridShellTerms::penalty_input(const Shell& S) const {
   ColliderPenaltyInput in;
   in.colliders = colliders_;
   in.mass = &S.gs->shell->mass;
   in.held = &S.held;
   in.dt = dt_;
   in.membrane = S.membrane;
-  return shellmpm::collider_penalty(in, S.X, grad ? &S.dX : nullptr, K);
+  return in;
+}
+
+double GridShellTerms::collider_penalty(Shell& S, bool grad, std::vector<Mat3d>* K) const {
+  return shellmpm::collider_penalty(penalty_input(S), S.X, grad ? &S.dX : nullptr, K);
+}
+
+double GridShellTerms::collider_work() const {
+  double w = 0;
+  for (const Shell& S : sh_)
+    shellmpm::collider_penalty(penalty_input(S), S.X, nullptr, nullptr, &w);
+  return w;
 }
 
 double GridShellTerms::energy(const std::vector<PadD>& vel) {

@@ -67,6 +67,9 @@ class GridShellTerms {
   /// the stiff sheet lag behind a ball pressing into it (2.5 mm of a 3 cm press at 1e-4 s),
   /// which the explicit path's per-step projection of the control points does not allow.
   void set_colliders(const std::vector<Collider>* colliders) { colliders_ = colliders; }
+  /// The moving colliders' work on the control points over the step through the penalty,
+  /// at the positions of the last evaluation [J] (collider_penalty.h).
+  double collider_work() const;
   /// The shells' own velocities at shared nodes (field_slots.h; null: none): a control
   /// point reads slot k's velocity (*slot_vel)[k] at a node of slot_of, and adds its
   /// offset. The objective's unknowns are then the nodes' 3 N_nodes components followed by
@@ -150,6 +153,7 @@ class GridShellTerms {
   /// The collider penalty of the control points at X into S.dX (with grad) and its
   /// Hessian kappa n n^T (with K: per control point, zero if none); returns its energy.
   double collider_penalty(Shell& S, bool grad, std::vector<Mat3d>* K) const;
+  ColliderPenaltyInput penalty_input(const Shell& S) const;
 
   const SparseGrid& grid_;
   const ShellPointTable& table_;

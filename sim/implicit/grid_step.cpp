@@ -34,6 +34,7 @@ class GridObjective final : public ImplicitObjective {
     fixed_.assign(3 * all, 1);
     normal_.assign(all, Vec3d::Zero());
     collider_of_.assign(all, -1);
+    sticky_of_.assign(all, -1);
     position_.assign(all, Vec3d::Zero());
     u0_.setZero(3 * m_.size());
     vbuf_.resize(grid_.num_particle_blocks());
@@ -106,26 +107,37 @@ class GridObjective final : public ImplicitObjective {
   /// stage's rule, with the constraint's impulse for the approach it stops): the normal
   /// impulse per unit mass the constraint applies at the solution u, j = (g . n) / m
   /// from the unprojected gradient, removes up to friction * j of the tangential
-  /// velocity relative to the collider.
-  void apply_friction(VecXd& u) {
+  /// velocity relative to the collider. Returns the moving colliders' work over the step
+  /// (energy_audit.h): each constrained node's impulse, g plus the friction's, times the
+  /// collider's velocity there, plus the penalty's on shell control points.
+  double apply_friction(VecXd& u) {
     VecXd g;
     raw_gradient(u, g);
+    double work = in_.shells ? in_.shells->collider_work() : 0.0;
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
+      if (sticky_of_[i] >= 0) {
+        const Collider& col = (*in_.colliders)[sticky_of_[i]];
+        if (col.animated()) work += g.segment<3>(3 * i).dot(col.velocity(position_[i]));
+      }
       if (collider_of_[i] < 0) continue;
       const Collider& col = (*in_.colliders)[collider_of_[i]];
       const double mu = col.desc().friction;
       const Vec3d& n = normal_[i];
       // m (u - v^n) - dt f = g: the constraint's impulse is g, its normal part g . n.
       const double j = g.segment<3>(3 * i).dot(n) / m_[i];
-      if (!(mu > 0) || !(j > 0)) continue;
       const Vec3d vc = col.velocity(position_[i]);
-      const Vec3d vr = u.segment<3>(3 * i) - vc;
+      const Vec3d before = u.segment<3>(3 * i);
+      if (col.animated()) work += g.segment<3>(3 * i).dot(vc);
+      if (!(mu > 0) || !(j > 0)) continue;
+      const Vec3d vr = before - vc;
       const double vn = vr.dot(n);
       const Vec3d vt = vr - vn * n;
       const double tn = vt.norm(), drop = mu * j;
       u.segment<3>(3 * i) =
           vc + vn * n + (tn <= drop ? Vec3d::Zero() : Vec3d(vt * (1 - drop / tn)));
+      if (col.animated()) work += m_[i] * (u.segment<3>(3 * i) - before).dot(vc);
     }
+    return work;
   }
 
  private:
@@ -230,6 +242,8 @@ class GridObjective final : public ImplicitObjective {
         if (kind == BoundaryKind::Sticky) {
           v = vc;
           for (int a = 0; a < 3; ++a) fixed_[3 * i + a] = 1;
+          sticky_of_[i] = static_cast<int>(k);
+          position_[i] = x;
         } else if (kind == BoundaryKind::Slip || (v - vc).dot(n) < 0) {
           v -= (v - vc).dot(n) * n;  // the collider's normal velocity, free along it
           normal_[i] = n;
@@ -438,6 +452,7 @@ class GridObjective final : public ImplicitObjective {
   std::vector<char> fixed_;
   std::vector<Vec3d> normal_;     // slip constraint normal per node (zero: none)
   std::vector<int> collider_of_;  // the collider of that constraint (-1: none)
+  std::vector<int> sticky_of_;    // the sticky collider holding the node (-1: none)
   std::vector<Vec3d> position_;   // the node's position where it has one
   std::vector<Pad> vbuf_, fbuf_;
 };
@@ -455,7 +470,8 @@ NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const Newton
   VecXd u = obj.initial();
   NewtonReport rep = newton_minimise(obj, u, opt);
   if (!rep.converged) return rep;
-  obj.apply_friction(u);
+  const double work = obj.apply_friction(u);
+  if (in.collider_work) *in.collider_work = work;
   if (in.slot_out) {
     const std::size_t ns = in.slots ? in.slots->num_slots() : 0;
     in.slot_out->resize(ns);

@@ -72,6 +72,9 @@ struct GridStepInput {
   /// With shells: `factorised` factorises the tangent on the nodes the shells reach
   /// (Jacobi elsewhere); `block_jacobi` keeps its diagonal.
   bool factorise = true;
+  /// On convergence (non-null): the moving colliders' work over the step [J]
+  /// (energy_audit.h).
+  double* collider_work = nullptr;
 };
 
 /// The objective of one grid step (for tests) and its start (v^n + dt g, constraints applied).

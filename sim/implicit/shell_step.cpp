@@ -82,6 +82,12 @@ class ShellObjective final : public ImplicitObjective {
   Eigen::Index size() const override { return static_cast<Eigen::Index>(3 * n_); }
   const VecXd& initial() const { return u0_; }
   const std::vector<Vec3d>& start() const { return x0_; }
+  /// The moving colliders' work through the penalty at x over dt (collider_penalty.h).
+  double collider_work(const std::vector<Vec3d>& x) const {
+    double w = 0;
+    collider_penalty(penalty_, x, nullptr, nullptr, &w);
+    return w;
+  }
 
   double energy(const VecXd& u) override {
     const std::vector<Vec3d> x = moved(u);
@@ -288,7 +294,8 @@ std::unique_ptr<ImplicitObjective> ShellImplicitStep::objective(
 NewtonReport ShellImplicitStep::step(ShellObject& sh, const Vec3d& gravity, double t, double dt,
                                      double theta, const NewtonOptions& opt,
                                      ImplicitPreconditioner pre, bool serial,
-                                     const std::vector<Collider>* colliders, std::uint64_t epoch) {
+                                     const std::vector<Collider>* colliders, std::uint64_t epoch,
+                                     double* collider_work) {
   sh.sync_double_kl(*kl_);
   if (epoch != epoch_) cache_->K.reset();
   epoch_ = epoch;
@@ -318,6 +325,7 @@ NewtonReport ShellImplicitStep::step(ShellObject& sh, const Vec3d& gravity, doub
     }
     if (!rep.converged) return rep;
     const std::vector<Vec3d> x = obj.moved(u);
+    if (collider_work) *collider_work += theta * obj.collider_work(x);
     for (std::size_t i = 0; i < sh.size(); ++i) {
       sh.x[i] = x[i].cast<Real>();
       sh.v[i] = u.segment<3>(3 * i).cast<Real>();

@@ -45,11 +45,14 @@ class ShellImplicitStep {
   explicit ShellImplicitStep(const ShellObject& sh);
   ~ShellImplicitStep();
 
-  /// One step of sh from t to t + dt. On convergence writes sh.x and sh.v; otherwise
-  /// leaves sh as it was. The report says which.
+  /// One step of sh from t to t + dt. On convergence writes sh.x and sh.v, and adds the
+  /// moving colliders' work through the penalty to *collider_work (when given; the
+  /// penalty's impulse times their velocity, collider_penalty.h); otherwise leaves sh as
+  /// it was. The report says which.
   NewtonReport step(ShellObject& sh, const Vec3d& gravity, double t, double dt, double theta,
                     const NewtonOptions& opt, ImplicitPreconditioner pre, bool serial,
-                    const std::vector<Collider>* colliders = nullptr, std::uint64_t epoch = 0);
+                    const std::vector<Collider>* colliders = nullptr, std::uint64_t epoch = 0,
+                    double* collider_work = nullptr);
   /// Denting plasticity inside the solve (KirchhoffLoveShellT::set_plasticity_in_energy).
   void set_plasticity_in_solve(bool on);
   /// Steps whose preconditioner reused an earlier step's stiffness (for tests).

@@ -44,6 +44,13 @@ std::vector<std::string> describe_integrity(const IntegrityReport& r, int frame,
            << e.value / dx << " dx): contact can leak between its control points; refine the "
            << "mesh or raise dx";
         break;
+      case IntegrityEvent::Kind::EnergyGain:
+        os << "the bodies gained " << e.value
+           << " J of energy that neither gravity, the colliders nor the sources supplied ("
+           << e.other << "; most in '" << e.object
+           << "'): a blow-up; a smaller shot.cfl or shot.dt_max may hold it (stats.json: "
+              "energy)";
+        break;
     }
     out.push_back(os.str());
   }

@@ -19,6 +19,9 @@ struct IntegrityEvent {
     NonFinite,          ///< non-finite positions or velocities (`object`: bulk or a shell)
     StretchedMesh,      ///< a warning, not a failure: edges of shell `object` longer than
                         ///< 2 dx, where contact can leak between its control points
+    EnergyGain,         ///< a warning (or a stop, shot.on_energy_gain): the frame gained
+                        ///< energy nothing supplied (energy_audit.h); `object` gained
+                        ///< most, `value` the excess [J]
   };
   Kind kind = Kind::BulkThroughShell;
   std::string object;  ///< the shell or collider concerned
@@ -51,13 +54,14 @@ struct IntegrityReport {
   double max_collider_depth = 0;          ///< deepest point inside any collider [m]
   double collider_limit = 0;              ///< the depth limit used (0.5 dx) [m]
   std::size_t non_finite = 0;             ///< non-finite positions or velocities
-  std::size_t stretched_edges = 0;        ///< contact-shell edges longer than 2 dx (a warning)
-  double max_edge = 0;                    ///< longest contact-shell limit-mesh edge [m]
-  double dx = 0;                          ///< grid spacing [m] (gaps are also written in cells)
-  GapSummary shell_shell;                 ///< shell vertices against other shells
-  GapSummary shell_bulk;                  ///< bulk particles against shells
-  GapSummary shell_collider;              ///< shell vertices against colliders
-  std::vector<IntegrityEvent> events;     ///< failures, then warnings
+  bool energy_gain = false;  ///< the energy audit failed (energy_audit.h; shot.on_energy_gain)
+  std::size_t stretched_edges = 0;     ///< contact-shell edges longer than 2 dx (a warning)
+  double max_edge = 0;                 ///< longest contact-shell limit-mesh edge [m]
+  double dx = 0;                       ///< grid spacing [m] (gaps are also written in cells)
+  GapSummary shell_shell;              ///< shell vertices against other shells
+  GapSummary shell_bulk;               ///< bulk particles against shells
+  GapSummary shell_collider;           ///< shell vertices against colliders
+  std::vector<IntegrityEvent> events;  ///< failures, then warnings
 
   bool failed() const {
     return bulk_crossings + shell_point_crossings + shell_crossing_edges + self_crossing_edges +

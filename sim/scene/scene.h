@@ -91,6 +91,9 @@ struct ShotSettings {
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
   enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;
+  /// What a frame that gained energy nothing supplied does (sim/integrity/energy_audit.h):
+  /// nothing, warn and go on, or stop (exit 1).
+  enum class OnEnergyGain { Ignore, Warn, Stop } on_energy_gain = OnEnergyGain::Warn;
 };
 
 enum class MaterialKind { Elastic, Sand, Snow };

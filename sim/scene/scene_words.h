@@ -43,6 +43,9 @@ SHELLMPM_ENUM_WORDS(ContactAt, 2, {"surface", ContactAt::Surface}, {"stencil", C
 SHELLMPM_ENUM_WORDS(ShotSettings::OnIntegrityFailure, 2,
                     {"warn", ShotSettings::OnIntegrityFailure::Warn},
                     {"stop", ShotSettings::OnIntegrityFailure::Stop});
+SHELLMPM_ENUM_WORDS(ShotSettings::OnEnergyGain, 3, {"ignore", ShotSettings::OnEnergyGain::Ignore},
+                    {"warn", ShotSettings::OnEnergyGain::Warn},
+                    {"stop", ShotSettings::OnEnergyGain::Stop});
 SHELLMPM_ENUM_WORDS(MaterialKind, 3, {"elastic", MaterialKind::Elastic},
                     {"sand", MaterialKind::Sand}, {"snow", MaterialKind::Snow});
 SHELLMPM_ENUM_WORDS(ElasticModel, 2, {"fixed_corotated", ElasticModel::FixedCorotated},

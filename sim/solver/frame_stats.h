@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "sim/core/types.h"
+#include "sim/integrity/energy_audit.h"
 #include "sim/integrity/integrity_report.h"
 
 namespace shellmpm {
@@ -61,8 +62,13 @@ struct FrameStats {
   std::size_t guard_unresolved = 0;  ///< pairs left closing at a step's end, summed
   bool implicit = false;             ///< shot.integrator implicit: `implicit_stats` is filled
   ImplicitStats implicit_stats;
-  /// What the integrity monitor found (crossings, collider penetration, non-finite).
+  /// What the integrity monitor found (crossings, collider penetration, non-finite, and
+  /// energy nothing supplied).
   IntegrityReport integrity;
+  /// Each bulk material's and shell's energies at the frame's end, and the frame's
+  /// energy balance (sim/integrity/energy_audit.h).
+  std::vector<BodyEnergy> bodies;
+  EnergyAudit energy;
   /// Wall-clock seconds per stage, in stage order (not deterministic, unlike the rest).
   std::vector<std::pair<std::string, double>> stage_seconds;
   double wall_seconds = 0;

@@ -9,6 +9,7 @@
 
 #include "sim/core/parallel.h"
 #include "sim/shell/preroll.h"
+#include "sim/solver/body_energies.h"
 #include "sim/solver/integrator_choice.h"
 #include "sim/solver/stages/registry.h"
 #include "sim/solver/stages/scene_rules.h"
@@ -37,6 +38,7 @@ Solver::Solver(const Scene& scene, SolverOptions opt) {
   }
   c_.shell_forces.resize(c_.shells.size());
   setup_contact();
+  energy_unjudged_ = energy_unjudged_reason(c_.scene);
   // The point order is read by the shells' transfers and the implicit solve; the bulk
   // transfers and the collider reach walk the blocks' runs.
   c_.grid.keep_order = !c_.grid_shells.empty() || s.integrator == Integrator::Implicit;
@@ -235,6 +237,9 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   for (Slot& st : stages_) st.seconds = 0;
   c_.guard_frame = ShellGuardStats{};
   c_.implicit_frame = ImplicitStats{};
+  c_.energy_supplied = 0;
+  c_.shell_dissipated.assign(c_.shells.size(), 0.0);
+  if (energy_start_.empty()) energy_start_ = body_energies(c_);
   ++c_.advance_epoch;
   FrameStats fs;
   fs.dt_min = std::numeric_limits<double>::infinity();
@@ -290,6 +295,7 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
   fs.time = c_.time;
   const auto m0 = clock::now();
   measure(fs);
+  fs.energy = audit_energy_frame(fs);
   const double measure_seconds = std::chrono::duration<double>(clock::now() - m0).count();
   fs.implicit = c_.scene.shot.integrator == Integrator::Implicit;
   fs.implicit_stats = c_.implicit_frame;
@@ -315,12 +321,9 @@ void Solver::measure(FrameStats& s) const {
   s.particles = n;
   s.grid_blocks = c_.grid.num_grid_blocks();
   struct Acc {
-    double ke = 0, pe = 0, m = 0, vmax = 0;
+    double vmax = 0;
     Vec3d mom = Vec3d::Zero();
     Acc& operator+=(const Acc& o) {
-      ke += o.ke;
-      pe += o.pe;
-      m += o.m;
       mom += o.mom;
       vmax = std::max(vmax, o.vmax);
       return *this;
@@ -328,23 +331,27 @@ void Solver::measure(FrameStats& s) const {
   };
   const Acc total = ordered_reduce(n, kParticleGrain, c_.opt.serial, Acc{}, [&](std::size_t i) {
     Acc a;
-    const auto mat = p.material_of(i);
-    const double m = static_cast<double>(p.volume_of(i)) * c_.densities[mat];
+    const double m = static_cast<double>(p.volume_of(i)) * c_.densities[p.material_of(i)];
     const Vec3d v = p.v[i].cast<double>();
-    a.m = m;
-    a.ke = 0.5 * m * v.squaredNorm();
     a.mom = m * v;
     a.vmax = v.norm();
-    a.pe = static_cast<double>(p.volume_of(i)) *
-           c_.models[mat].energy(p.F[i], p.has_plastic() ? p.plastic[i] : Real(1));
     return a;
   });
+  s.bodies = body_energies(c_);
+  for (const BodyEnergy& b : s.bodies) {
+    if (b.shell) {
+      s.shell_kinetic_energy += b.kinetic;
+      s.shell_membrane_energy += b.membrane;
+      s.shell_bending_energy += b.bending;
+      s.contact_energy += b.stored - b.membrane - b.bending;
+    } else {
+      s.kinetic_energy += b.kinetic;
+      s.elastic_energy += b.stored;
+      s.mass += b.mass;
+    }
+  }
   for (const auto& sh : c_.shells) {
-    const KirchhoffLoveShell::Energy e = sh->kl().energy(sh->x.data(), nullptr, c_.opt.serial);
     s.shell_points += sh->size();
-    s.shell_kinetic_energy += sh->kinetic_energy();
-    s.shell_membrane_energy += static_cast<double>(e.membrane);
-    s.shell_bending_energy += static_cast<double>(e.bending);
     s.shell_max_strain = std::max(s.shell_max_strain, sh->max_strain());
   }
   s.shell_plastic_work = c_.plastic_work;
@@ -352,10 +359,7 @@ void Solver::measure(FrameStats& s) const {
     const ShellObject& sh = *c_.shells[i];
     for (std::size_t j = 0; j < sh.size(); ++j)
       s.shell_momentum += static_cast<double>(sh.mass[j]) * sh.v[j].cast<double>();
-    if (!c_.contacts[i]) continue;
-    const ShellContact& c = *c_.contacts[i];
-    s.contact_particles += c.num_sites();
-    s.contact_energy += c.energy(sh.x.data(), c_.opt.serial);
+    if (c_.contacts[i]) s.contact_particles += c_.contacts[i]->num_sites();
   }
   s.contact_compressed = c_.contact_step.compressed;
   s.contact_sliding = c_.contact_step.sliding;
@@ -365,11 +369,39 @@ void Solver::measure(FrameStats& s) const {
   s.guard_impulses = c_.guard_frame.impulses;
   s.guard_zoned = c_.guard_frame.zoned;
   s.guard_unresolved = c_.guard_frame.unresolved;
-  s.kinetic_energy = total.ke;
-  s.elastic_energy = total.pe;
-  s.mass = total.m;
   s.momentum = total.mom;
   s.max_speed = total.vmax;
+}
+
+EnergyAudit Solver::audit_energy_frame(FrameStats& fs) {
+  const std::size_t nm = c_.scene.materials.size();
+  std::vector<double> dissipated(nm, 0.0);
+  dissipated.insert(dissipated.end(), c_.shell_dissipated.begin(), c_.shell_dissipated.end());
+  double mass = 0;
+  for (const BodyEnergy& b : fs.bodies) mass += b.mass;
+  const double floor = kEnergyFloor * mass * kStandardGravity * c_.scene.shot.dx;
+  EnergyAudit a = audit_energy(energy_start_, fs.bodies, dissipated, c_.energy_supplied, floor);
+  energy_start_ = fs.bodies;
+  if (a.judged && !energy_unjudged_.empty()) {
+    a.judged = false;
+    a.reason = energy_unjudged_;
+  }
+  if (a.failed() && c_.scene.shot.on_energy_gain != ShotSettings::OnEnergyGain::Ignore) {
+    IntegrityEvent e;
+    e.kind = IntegrityEvent::Kind::EnergyGain;
+    e.object = a.object;
+    e.value = a.excess;
+    std::ostringstream os;
+    os.precision(3);
+    os << "start " << a.start << " J, end " << a.end << " J, dissipated " << a.dissipated
+       << " J, supplied " << a.supplied << " J";
+    e.other = os.str();
+    fs.integrity.events.push_back(e);  // after the failures, with the warnings
+    fs.integrity.energy_gain = true;
+    fs.integrity.active = true;
+    fs.integrity.dx = c_.scene.shot.dx;
+  }
+  return a;
 }
 
 int Solver::preroll(const PrerollSettings& p) {

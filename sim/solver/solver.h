@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sim/core/simulation_error.h"
+#include "sim/integrity/energy_audit.h"
 #include "sim/integrity/integrity_monitor.h"
 #include "sim/solver/frame_stats.h"
 #include "sim/solver/stages/stage.h"
@@ -92,9 +93,15 @@ class Solver {
   IntegrityView integrity_view() const;
   void setup_contact();
 
+  /// The energy audit's frame (energy_audit.h): the bodies' energies at its start are
+  /// those at the last frame's end, measured afresh after a construction or a resume.
+  EnergyAudit audit_energy_frame(FrameStats& fs);
+
   StepContext c_;
   std::vector<Slot> stages_;
   IntegrityMonitor integrity_;
+  std::vector<BodyEnergy> energy_start_;  ///< empty: not measured yet
+  std::string energy_unjudged_;           ///< energy_unjudged_reason of the scene
 };
 
 }  // namespace shellmpm

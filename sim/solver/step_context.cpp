@@ -131,6 +131,15 @@ bool StepContext::shell_field_rule(ShellFields::SkipFn& skip, ShellFields::Colli
     for (std::size_t k = 0; k < colliders.size(); ++k)
       if (collider_reach.engaged(g, n, k)) colliders[k].apply(x, v);
   };
+  gate.velocity = [this, node_at](std::size_t g, int n) -> Vec3d {
+    const Vec3d x = grid.node_position(node_at(g, n));
+    for (std::size_t k = 0; k < colliders.size(); ++k) {
+      if (!collider_reach.engaged(g, n, k)) continue;
+      if (colliders[k].phi(x) > 0) continue;
+      return colliders[k].animated() ? colliders[k].velocity(x) : Vec3d::Zero();
+    }
+    return Vec3d::Zero();
+  };
   gate.reach = static_cast<Real>(kColliderReachCells * grid.dx());
   return true;
 }
@@ -143,6 +152,11 @@ void StepContext::add_particles_from(std::size_t i, const std::vector<Vec3d>& pt
   const Real pl0 = models[mat].initial_plastic();
   particles.reserve_more(pts.size(), false);
   for (const Vec3d& p : pts) particles.push_back(p.cast<Real>(), vel, vol, mat, pl0);
+}
+
+void StepContext::add_dissipation(const ShellObject* sh, double w) {
+  for (std::size_t i = 0; i < shells.size() && i < shell_dissipated.size(); ++i)
+    if (shells[i].get() == sh) shell_dissipated[i] += w;
 }
 
 }  // namespace shellmpm

@@ -94,6 +94,13 @@ struct StepContext {
   ImplicitStats implicit_frame;
   double friction_work = 0;  ///< [J]
   double plastic_work = 0;   ///< [J]
+  // The frame's energy ledger (sim/integrity/energy_audit.h; the solver zeroes it at a
+  // frame's start): colliders, implicit_grid, collider_particles and emit add what they
+  // supply; denting and friction add each shell's dissipation.
+  double energy_supplied = 0;            ///< [J]
+  std::vector<double> shell_dissipated;  ///< per shell, in scene order [J]
+  /// Adds w to the frame's dissipation of shell sh (one of `shells`).
+  void add_dissipation(const ShellObject* sh, double w);
 
   /// Transfer settings for this step (dt, APIC or MLS, materials, where bulk starts).
   TransferParams transfer_params() const;

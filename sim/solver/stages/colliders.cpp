@@ -18,6 +18,8 @@ void CollidersStage::run(StepContext& c) {
   if (c.shell_fields.contact_at_surfaces())
     c.shell_fields.keep_free_velocities(c.grid, c.opt.serial);
   const double dx = c.grid.dx();
+  // The work of the moving colliders (energy_audit.h): per block, summed in block order.
+  work_.assign(c.grid.num_grid_blocks(), 0.0);
   parallel_for_each(
       c.grid.num_grid_blocks(), 16,
       [&](std::size_t b) {
@@ -32,7 +34,12 @@ void CollidersStage::run(StepContext& c) {
             const Vec3i l = n - corner;
             if (!c.collider_reach.engaged(b, block_node(l[0], l[1], l[2]), k)) return;
             Vec3 v(nd.v[0], nd.v[1], nd.v[2]);
-            if (col.apply(c.grid.node_position(n), v)) {
+            const Vec3d x = c.grid.node_position(n);
+            if (col.apply(x, v)) {
+              if (col.animated()) {
+                const Vec3d dv(v[0] - nd.v[0], v[1] - nd.v[1], v[2] - nd.v[2]);
+                work_[b] += static_cast<double>(nd.m) * dv.dot(col.velocity(x));
+              }
               nd.v[0] = v[0];
               nd.v[1] = v[1];
               nd.v[2] = v[2];
@@ -41,6 +48,7 @@ void CollidersStage::run(StepContext& c) {
         }
       },
       c.opt.serial);
+  for (const double w : work_) c.energy_supplied += w;
   // The domain walls after the colliders: a ground within kWallCells of the domain's edge
   // must see the node's velocity into it, or the wall (frictionless) would zero it first
   // and the ground's Coulomb friction, which scales with that velocity, would never act

@@ -1,6 +1,8 @@
 // Stage "colliders": Collider boundary conditions on grid nodes (each collider posed for this
 // step).
 #pragma once
+#include <vector>
+
 #include "sim/solver/stages/stage.h"
 
 namespace shellmpm {
@@ -10,6 +12,9 @@ class CollidersStage final : public Stage {
   static bool needed(const Scene& s);
   std::string_view name() const override { return "colliders"; }
   void run(StepContext& c) override;
+
+ private:
+  std::vector<double> work_;  ///< per grid block: the moving colliders' work this step [J]
 };
 
 }  // namespace shellmpm

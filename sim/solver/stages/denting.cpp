@@ -9,7 +9,11 @@ bool DentingStage::needed(const Scene& s) {
 }
 
 void DentingStage::run(StepContext& c) {
-  for (auto& sh : c.shells) c.plastic_work += sh->project_plasticity(c.opt.serial);
+  for (auto& sh : c.shells) {
+    const double w = sh->project_plasticity(c.opt.serial);
+    c.plastic_work += w;
+    c.add_dissipation(sh.get(), w);
+  }
 }
 
 }  // namespace shellmpm

@@ -14,6 +14,12 @@ void EmitStage::run(StepContext& c) {
     std::vector<Vec3d> pts;
     c.samplers[i].emit(c.time, c.dt, [&](const Vec3d& p) { pts.push_back(p); });
     c.add_particles_from(i, pts);
+    // What the new particles bring (energy_audit.h): kinetic and potential energy.
+    const SourceDesc& src = c.scene.sources[i];
+    const double m = c.samplers[i].particle_volume() * c.densities[src.material];
+    const Vec3d g = c.scene.shot.gravity;
+    for (const Vec3d& p : pts)
+      c.energy_supplied += m * (0.5 * src.velocity.squaredNorm() - g.dot(p));
   }
 }
 

@@ -26,6 +26,7 @@ void FrictionStage::run(StepContext& c) {
     total.compressed += st.compressed;
     total.sliding += st.sliding;
     total.friction_work += st.friction_work;
+    c.add_dissipation(g.shell, st.friction_work);
     total.separation_work += st.separation_work;
   }
   c.friction_work += total.friction_work;

@@ -26,6 +26,7 @@ void G2pStage::run(StepContext& c) {
     ShellFields::ColliderGate gate;
     const bool gated = c.shell_field_rule(skip, gate);
     c.shell_fields.before_g2p(c.grid, skip, c.opt.serial, gated ? &gate : nullptr);
+    if (gated) c.energy_supplied += c.shell_fields.gate_work();
   }
   grid_to_particles(c.particles, c.grid, tp);
   if (fields) c.shell_fields.after_g2p(c.grid_shells, dt, c.opt.serial);

@@ -85,6 +85,8 @@ void ImplicitGridStage::run(StepContext& c) {
       in.shells = shells.get();
     }
     if (in.slots && regroups == 0) before = c.grid.gblock_nodes;
+    double work = 0;
+    in.collider_work = &work;
     const NewtonReport rep = implicit_grid_step(in, dt, opt);
     c.implicit_frame.add(rep.iterations, rep.cg_iterations, rep.residual);
     iterations = rep.iterations;
@@ -98,7 +100,10 @@ void ImplicitGridStage::run(StepContext& c) {
       pose_slots();
       continue;
     }
-    if (rep.converged) break;
+    if (rep.converged) {
+      c.energy_supplied += work;
+      break;
+    }
     in.start = nullptr;  // a shorter step starts afresh
     retried = true;
     ++c.implicit_frame.retries;

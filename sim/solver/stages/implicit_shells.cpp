@@ -39,11 +39,12 @@ void ImplicitShellsStage::advance(StepContext& c, double t, double dt) {
   opt.refresh_after = 2;
   // The colliders at this (sub)step's end; the collider stages pose them again for theirs.
   for (Collider& col : c.colliders) col.begin_step(t, dt);
+  double work = 0;  // the colliders' work, kept once every shell's step is taken
   for (std::size_t i = 0; i < c.shells.size(); ++i) {
     if (!steps_[i]) continue;
-    const NewtonReport rep =
-        steps_[i]->step(*c.shells[i], shot.gravity, t, dt, shot.implicit_theta, opt,
-                        shot.implicit_preconditioner, c.opt.serial, &c.colliders, c.advance_epoch);
+    const NewtonReport rep = steps_[i]->step(*c.shells[i], shot.gravity, t, dt, shot.implicit_theta,
+                                             opt, shot.implicit_preconditioner, c.opt.serial,
+                                             &c.colliders, c.advance_epoch, &work);
     c.implicit_frame.add(rep.iterations, rep.cg_iterations, rep.residual);
     if (rep.converged) continue;
     // Every shell back to the start, then the step in two halves.
@@ -68,6 +69,7 @@ void ImplicitShellsStage::advance(StepContext& c, double t, double dt) {
     advance(c, t + 0.5 * dt, 0.5 * dt);
     return;
   }
+  c.energy_supplied += work;
 }
 
 }  // namespace shellmpm

@@ -1,0 +1,176 @@
+// The energy audit (sim/integrity/energy_audit.h): its balance on known numbers, the
+// colliders' work it counts (a paddle that pushes a block supplies the energy the block
+// gains, explicit and implicit), and a frame that gains energy nothing supplied, which
+// it reports as a failure naming the body.
+#include <catch2/catch.hpp>
+
+#include "sim/integrity/energy_audit.h"
+#include "sim/solver/body_energies.h"
+#include "sim/solver/solver.h"
+
+using namespace shellmpm;
+
+namespace {
+
+BodyEnergy body(const std::string& name, double kinetic, double stored, double potential) {
+  BodyEnergy b;
+  b.name = name;
+  b.kinetic = kinetic;
+  b.stored = stored;
+  b.potential = potential;
+  b.mass = 1;
+  return b;
+}
+
+/// A jelly block (0.2 m cube) at rest, without gravity, and a separating paddle that
+/// comes from -x at `speed` and pushes it along +x.
+Scene paddle_scene(double speed, Integrator integrator) {
+  Scene s;
+  s.path = "test";
+  s.shot.dx = 0.04;
+  s.shot.domain_min = Vec3d(-0.6, -0.4, -0.4);
+  s.shot.domain_max = Vec3d(1.0, 0.4, 0.4);
+  s.shot.fps = 24;
+  s.shot.gravity = Vec3d::Zero();
+  s.shot.integrator = integrator;
+  s.shot.dt_max = 1.0 / 240;
+  MaterialDesc m;
+  m.name = "jelly";
+  m.youngs_modulus = 2e4;
+  m.density = 1000;
+  s.materials.push_back(m);
+  SourceDesc src;
+  src.shape.kind = ShapeDesc::Kind::Box;
+  src.shape.min = Vec3d(-0.1, -0.1, -0.1);
+  src.shape.max = Vec3d(0.1, 0.1, 0.1);
+  s.sources.push_back(src);
+  ColliderDesc c;
+  c.name = "paddle";
+  c.shape.kind = ShapeDesc::Kind::Box;
+  c.shape.min = Vec3d(-0.3, -0.2, -0.2);
+  c.shape.max = Vec3d(-0.14, 0.2, 0.2);
+  c.boundary = BoundaryKind::Separate;
+  Keyframe k0, k1;
+  k1.time = 1.0;
+  k1.translate = Vec3d(speed, 0, 0);
+  c.keyframes = {k0, k1};
+  s.colliders.push_back(c);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("the energy audit balances the bodies' energy, dissipation and supply",
+          "[integrity][energy]") {
+  const std::vector<BodyEnergy> start = {body("sand", 1.0, 2.0, -3.0), body("can", 0.5, 0.5, 0.0)};
+  // Sand falls: 1 J of potential energy into kinetic; the can dents, 0.4 J of its stored
+  // energy dissipated. Nothing supplied: no excess.
+  std::vector<BodyEnergy> end = {body("sand", 2.0, 2.0, -4.0), body("can", 0.5, 0.1, 0.0)};
+  EnergyAudit a = audit_energy(start, end, {0.0, 0.4}, 0.0, 1e-6);
+  REQUIRE(a.judged);
+  CHECK(a.start == Approx(1.0));
+  CHECK(a.end == Approx(0.6));
+  CHECK(a.dissipated == Approx(0.4));
+  CHECK(std::abs(a.excess) < 1e-12);
+  CHECK_FALSE(a.failed());
+  // The can dissipates 40 J more than it had: energy from nowhere, and the can named.
+  EnergyAudit b = audit_energy(start, end, {0.0, 40.4}, 0.0, 1e-6);
+  CHECK(b.excess == Approx(40.0));
+  CHECK(b.failed());
+  CHECK(b.object == "can");
+  CHECK(b.object_gain == Approx(40.0));
+  // The same with 40 J supplied (a collider pressed the can): balanced.
+  EnergyAudit c = audit_energy(start, end, {0.0, 40.4}, 40.0, 1e-6);
+  CHECK(std::abs(c.excess) < 1e-9);
+  CHECK_FALSE(c.failed());
+  // Within the tolerance: a small excess passes, one beyond it fails.
+  end[0].kinetic += 0.1;
+  CHECK_FALSE(audit_energy(start, end, {0.0, 0.4}, 0.0, 1e-6).failed());
+  end[0].kinetic += 10;
+  CHECK(audit_energy(start, end, {0.0, 0.4}, 0.0, 1e-6).failed());
+  // Bodies that do not match are not judged.
+  end.pop_back();
+  CHECK_FALSE(audit_energy(start, end, {0.0}, 0.0, 1e-6).judged);
+}
+
+TEST_CASE("a paddle pushing a block supplies the energy the block gains", "[integrity][energy]") {
+  const double speed = 0.5;
+  for (const Integrator integ : {Integrator::Explicit, Integrator::Implicit}) {
+    CAPTURE(integ == Integrator::Implicit);
+    Solver solver(paddle_scene(speed, integ));
+    double supplied = 0, dissipated = 0;
+    FrameStats fs;
+    for (int f = 1; f <= 8; ++f) {
+      fs = solver.advance_to(f / 24.0);
+      CAPTURE(f, fs.energy.excess, fs.energy.tolerance, fs.energy.supplied);
+      REQUIRE(fs.energy.judged);
+      REQUIRE_FALSE(fs.energy.failed());
+      REQUIRE_FALSE(fs.integrity.energy_gain);
+      supplied += fs.energy.supplied;
+      dissipated += fs.energy.dissipated;
+    }
+    REQUIRE(fs.bodies.size() == 1);
+    const double mass = fs.bodies[0].mass, gained = fs.bodies[0].total();
+    // The block has been struck and moves at about the paddle's speed or faster.
+    CHECK(fs.kinetic_energy > 0.5 * mass * speed * speed);
+    // All of its energy came from the paddle, and the paddle's work is not overstated
+    // by more than what the transfers and the contact dissipate (a third here).
+    CHECK(supplied >= gained);
+    CHECK(supplied < 1.5 * gained + 1e-9);
+    CHECK(dissipated == 0);
+  }
+}
+
+TEST_CASE("energy that nothing supplied fails the frame and names the body",
+          "[integrity][energy]") {
+  Solver solver(paddle_scene(0.0, Integrator::Explicit));  // a paddle that stays put
+  FrameStats fs = solver.advance_to(1 / 24.0);
+  REQUIRE(fs.energy.judged);
+  CHECK_FALSE(fs.integrity.failed());
+  // Between frames the block is set moving at 2 m/s: the next frame's start is the last
+  // one's end, so the frame gains that kinetic energy with nothing to account for it.
+  for (Vec3& v : solver.particles().v) v = Vec3(0, 2, 0);
+  fs = solver.advance_to(2 / 24.0);
+  REQUIRE(fs.energy.judged);
+  CHECK(fs.energy.failed());
+  CHECK(fs.energy.excess > 0.9 * 0.5 * fs.bodies[0].mass * 4);
+  CHECK(fs.energy.object == "jelly");
+  // A warning by default (shot.on_energy_gain: warn), not a failed integrity check.
+  CHECK(fs.integrity.energy_gain);
+  CHECK_FALSE(fs.integrity.failed());
+  REQUIRE(fs.integrity.events.size() == 1);
+  CHECK(fs.integrity.events.front().kind == IntegrityEvent::Kind::EnergyGain);
+  CHECK(fs.integrity.events.front().object == "jelly");
+  const std::vector<std::string> lines = describe_integrity(fs.integrity, 2, 0.04);
+  REQUIRE(!lines.empty());
+  CHECK(lines.front().find("frame 2: the bodies gained") == 0);
+  CHECK(lines.front().find("'jelly'") != std::string::npos);
+  // The frame after is sound again.
+  fs = solver.advance_to(3 / 24.0);
+  CHECK_FALSE(fs.energy.failed());
+  CHECK_FALSE(fs.integrity.energy_gain);
+  // With shot.on_energy_gain: ignore the balance is kept but nothing is reported.
+  Scene quiet = paddle_scene(0.0, Integrator::Explicit);
+  quiet.shot.on_energy_gain = ShotSettings::OnEnergyGain::Ignore;
+  Solver q(quiet);
+  q.advance_to(1 / 24.0);
+  for (Vec3& v : q.particles().v) v = Vec3(0, 2, 0);
+  fs = q.advance_to(2 / 24.0);
+  CHECK(fs.energy.failed());
+  CHECK_FALSE(fs.integrity.energy_gain);
+  CHECK(fs.integrity.events.empty());
+}
+
+TEST_CASE("frames with inputs the audit does not count are not judged", "[integrity][energy]") {
+  Scene s;
+  s.shells.emplace_back();
+  s.shells.back().name = "flag";
+  CHECK(energy_unjudged_reason(s).empty());
+  s.shells.back().pressure = 10;
+  CHECK(energy_unjudged_reason(s).find("pressure") != std::string::npos);
+  s.shells.back().pressure = 0;
+  PinDesc pin;
+  pin.keyframes = {Keyframe{}, Keyframe{}};
+  s.shells.back().pins.push_back(pin);
+  CHECK(energy_unjudged_reason(s).find("moving pin") != std::string::npos);
+}
