@@ -31,6 +31,7 @@ struct ProjectionStats {
   /// each point's impulse m (v' - v) times a moving collider's velocity there (a static
   /// collider's impulse does no work), plus the potential energy of moving it, -m g . dx.
   double work = 0;
+  std::size_t moving = 0;  ///< points a moving collider moved
 };
 
 /// What ProjectionStats::work is measured with.

@@ -15,7 +15,8 @@
 // - in implicit steps, the constraint impulses of the grid solve and the collider
 //   penalty's impulses on shell control points;
 // - through the projection of points out of colliders, plus the potential energy it
-//   moves them by and, for a shell, the change of what it stores;
+//   moves them by and, for a shell a moving collider moved, the change of what it
+//   stores;
 // and the kinetic and potential energy of emitted particles.
 // Backward Euler, APIC/MLS transfers, the return mappings of sand, snow and contact,
 // inelastic contact and damping only remove energy, so

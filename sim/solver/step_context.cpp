@@ -131,15 +131,19 @@ bool StepContext::shell_field_rule(ShellFields::SkipFn& skip, ShellFields::Colli
     for (std::size_t k = 0; k < colliders.size(); ++k)
       if (collider_reach.engaged(g, n, k)) colliders[k].apply(x, v);
   };
-  gate.velocity = [this, node_at](std::size_t g, int n) -> Vec3d {
-    const Vec3d x = grid.node_position(node_at(g, n));
-    for (std::size_t k = 0; k < colliders.size(); ++k) {
-      if (!collider_reach.engaged(g, n, k)) continue;
-      if (colliders[k].phi(x) > 0) continue;
-      return colliders[k].animated() ? colliders[k].velocity(x) : Vec3d::Zero();
-    }
-    return Vec3d::Zero();
-  };
+  // The moving colliders' velocity, for the energy audit (none when all are static).
+  bool moving = false;
+  for (const Collider& col : colliders) moving = moving || col.animated();
+  if (moving)
+    gate.velocity = [this, node_at](std::size_t g, int n) -> Vec3d {
+      const Vec3d x = grid.node_position(node_at(g, n));
+      for (std::size_t k = 0; k < colliders.size(); ++k) {
+        if (!collider_reach.engaged(g, n, k)) continue;
+        if (colliders[k].phi(x) > 0) continue;
+        return colliders[k].animated() ? colliders[k].velocity(x) : Vec3d::Zero();
+      }
+      return Vec3d::Zero();
+    };
   gate.reach = static_cast<Real>(kColliderReachCells * grid.dx());
   return true;
 }

@@ -19,8 +19,8 @@ void ColliderParticlesStage::run(StepContext& c) {
   std::vector<std::uint8_t> held;
   std::vector<Vec3d> target;
   // What the projections supply (energy_audit.h): the points' impulses times moving
-  // colliders' velocities and their potential energy, and for a shell whose points moved,
-  // the change of what it stores.
+  // colliders' velocities and their potential energy, and for a shell a moving collider
+  // moved, the change of what it stores (two energy evaluations, only then).
   ProjectionWork work;
   work.gravity = c.scene.shot.gravity;
   const auto project_shell = [&](std::size_t i, const std::vector<std::uint8_t>* pinned) {
@@ -30,7 +30,7 @@ void ColliderParticlesStage::run(StepContext& c) {
     const ProjectionStats st = project_out_of_colliders(c.colliders, dx, c.dt, sh.x, sh.v, pinned,
                                                         c.opt.serial, c.contact_offset(sh), &work);
     c.energy_supplied += st.work;
-    if (st.inside + st.swept == 0) return;
+    if (st.moving == 0) return;  // a static collider does no work
     const double after = shell_stored_energy(c, i);
     std::swap(sh.x, x_before_);
     const double before = shell_stored_energy(c, i);
