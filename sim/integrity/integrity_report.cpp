@@ -48,8 +48,8 @@ std::vector<std::string> describe_integrity(const IntegrityReport& r, int frame,
         os << "the bodies gained " << e.value
            << " J of energy that neither gravity, the colliders nor the sources supplied ("
            << e.other << "; most in '" << e.object
-           << "'): a blow-up; a smaller shot.cfl or shot.dt_max may hold it (stats.json: "
-              "energy)";
+           << "'): a blow-up, or contact pushing bodies apart (stats.json: energy; "
+              "docs/integrity.md)";
         break;
     }
     out.push_back(os.str());
