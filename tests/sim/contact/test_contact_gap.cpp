@@ -94,7 +94,7 @@ TEST_CASE("bodies closing faster than the gap allows close exactly by it", "[con
     Vec3 va(0, 0, 0), vb(0, Real(-0.1), 0);
     CHECK(field_contact(n, 0, 1, va, 1, vb, closing_allowance(0, dt)));
     CHECK(double((vb - va).y()) == Approx(0.0).margin(1e-7));
-    // 1 mm of overlap: at least a quarter of it undone within the step.
+    // 1 mm of overlap at a 1 ms step: a quarter of it undone within the step.
     const Real back = closing_allowance(Real(-1e-3), dt);
     CHECK(double(back) == Approx(-0.25));
     va = Vec3::Zero();
@@ -106,4 +106,20 @@ TEST_CASE("bodies closing faster than the gap allows close exactly by it", "[con
     vb = Vec3(0, 1, 0);
     CHECK_FALSE(field_contact(n, 0, 1, va, 1, vb, back));
   }
+}
+
+TEST_CASE("an overlap is undone at a rate that does not grow as the step shrinks",
+          "[contact_gap]") {
+  const Real overlap = Real(-1e-4);
+  // Frame-sized steps: a quarter of the overlap per step.
+  CHECK(double(closing_allowance(overlap, Real(1) / 240)) == Approx(-0.25 * 1e-4 * 240));
+  CHECK(double(closing_allowance(overlap, Real(1) / 4000)) == Approx(-0.25 * 1e-4 * 4000));
+  // Shorter steps, down to stiff steel's explicit step (1e-7 s): 0.1 mm parts at 0.1 m/s,
+  // not the 250 m/s of a quarter per step.
+  for (const Real dt : {Real(1e-4), Real(1e-5), Real(1e-7)}) {
+    INFO("dt " << dt);
+    CHECK(double(closing_allowance(overlap, dt)) == Approx(-1000 * 1e-4));
+  }
+  // While apart the bodies may close by the whole gap within the step, at any step.
+  CHECK(double(closing_allowance(Real(1e-4), Real(1e-7))) == Approx(1e3));
 }
