@@ -195,7 +195,7 @@ bool ShellFields::regroup(const SparseGrid& combined,
 }
 
 void ShellFields::take_solution(const SparseGrid& combined, const FieldSlots& fs,
-                                const std::vector<Vec3>& slot_vel, bool) {
+                                const std::vector<Vec3>& slot_vel) {
   for (const auto& [r, k] : slot_r_) {
     const std::uint32_t gi = fs.slot_node[std::size_t(k)];
     const GridNode& nd = combined.gblock_nodes[gi / kBlockNodes][gi % kBlockNodes];

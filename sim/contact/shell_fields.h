@@ -147,7 +147,7 @@ class ShellFields {
   /// at the slotted nodes, relative to u, from its group's unknown (slot_vel per slot).
   /// before_g2p leaves those nodes as they are.
   void take_solution(const SparseGrid& combined, const FieldSlots& fs,
-                     const std::vector<Vec3>& slot_vel, bool serial);
+                     const std::vector<Vec3>& slot_vel);
   /// After a solve (the combined grid holds its node velocities; `before`: its nodes as
   /// P2G left them): the rule again on the solved velocities at the slotted nodes. Where
   /// two groups close on each other faster than their gap allows, they are joined, with

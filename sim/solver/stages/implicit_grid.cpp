@@ -120,7 +120,7 @@ void ImplicitGridStage::run(StepContext& c) {
       throw SimulationError(os.str());
     }
   }
-  if (in.slots) c.shell_fields.take_solution(c.grid, slots, slot_vel, c.opt.serial);
+  if (in.slots) c.shell_fields.take_solution(c.grid, slots, slot_vel);
   if (retried)
     cap_ = dt;
   else if (cap_ > 0 && 3 * iterations <= opt.max_iterations)

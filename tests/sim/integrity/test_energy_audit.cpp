@@ -143,6 +143,7 @@ TEST_CASE("energy that nothing supplied fails the frame and names the body",
   CHECK(fs.integrity.events.front().object == "jelly");
   const std::vector<std::string> lines = describe_integrity(fs.integrity, 2, 0.04);
   REQUIRE(!lines.empty());
+  INFO("the warning: " << lines.front());
   CHECK(lines.front().find("frame 2: the bodies gained") == 0);
   CHECK(lines.front().find("'jelly'") != std::string::npos);
   // The frame after is sound again.
