@@ -10,9 +10,14 @@ namespace {
 
 constexpr std::size_t kGrain = 4096;
 
-// One point against one collider; returns 1 if moved out from inside, 2 if swept, each
-// plus 2 when the collider moves. Adds the velocity change times a moving collider's
-// velocity to wv.
+// What project_point did to a point, as bit flags (0: nothing).
+constexpr int kMovedOut = 1;      // moved out from inside the collider
+constexpr int kSweptBack = 2;     // put back where its path entered the collider
+constexpr int kByMovingBody = 4;  // the collider moves (its work is in wv)
+
+// One point against one collider; returns kMovedOut or kSweptBack, with kByMovingBody
+// when the collider moves. Adds the velocity change times a moving collider's velocity
+// to wv.
 int project_point(const Collider& c, double dx, double dt, double offset, bool sweep, Vec3& xr,
                   Vec3& v, double& wv) {
   const Vec3d x = xr.cast<double>();
@@ -31,9 +36,9 @@ int project_point(const Collider& c, double dx, double dt, double offset, bool s
     xr = y.cast<Real>();
     const Vec3 v0 = v;
     v = c.resolve(y, n, v);
-    if (!c.animated()) return 1;
+    if (!c.animated()) return kMovedOut;
     wv += (v - v0).cast<double>().dot(c.velocity(y));
-    return 3;
+    return kMovedOut | kByMovingBody;
   }
   const int samples = sweep ? static_cast<int>(std::ceil(len / (0.5 * dx))) : 0;
   if (samples < 2) return 0;
@@ -46,9 +51,9 @@ int project_point(const Collider& c, double dx, double dt, double offset, bool s
       xr = last.cast<Real>();
       const Vec3 v0 = v;
       v = c.resolve(last, n, v);
-      if (!c.animated()) return 2;
+      if (!c.animated()) return kSweptBack;
       wv += (v - v0).cast<double>().dot(c.velocity(last));
-      return 4;
+      return kSweptBack | kByMovingBody;
     }
     last = y;
   }
@@ -75,9 +80,9 @@ ProjectionStats project_out_of_colliders(const std::vector<Collider>& colliders,
           for (int pass = 0; pass < 2 && (pass == 0 || moved); ++pass)
             for (const Collider& c : colliders) {
               const int r = project_point(c, dx, dt, offset, pass == 0, x[i], v[i], wv);
-              st.inside += r == 1 || r == 3;
-              st.swept += r == 2 || r == 4;
-              st.moving += r > 2;
+              st.inside += (r & kMovedOut) != 0;
+              st.swept += (r & kSweptBack) != 0;
+              st.moving += (r & kByMovingBody) != 0;
               moved = moved || r != 0;
             }
           if (moved && work)
