@@ -253,6 +253,11 @@ SHELLMPM_BLOCKS_INLINE void g2p(const SparseGrid& grid, const std::uint32_t* ord
     const Vec3& v = G.v;
     gs.contact->C[j] = c_scale * G.B;
     const std::uint8_t held = gs.held[j];
+    if (held) {
+      // The pin makes up the difference (pin_transfer_work).
+      for (int a = 0; a < 3; ++a)
+        if (held & (1u << a)) gs.pin_impulse[j][a] = sh.mass[j] * (sh.v[j][a] - v[a]);
+    }
     for (int a = 0; a < 3; ++a)
       if (!(held & (1u << a))) sh.v[j][a] = v[a];
     sh.x[j] += dt * sh.v[j];

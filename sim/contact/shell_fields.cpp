@@ -718,7 +718,10 @@ void ShellFields::after_g2p(std::vector<GridShell>& shells, Real dt, bool serial
       // would see it moving.
       const std::uint8_t held = gs.held[j];
       for (int a = 0; a < 3; ++a)
-        if (held & (1u << a)) dv[a] = 0;
+        if (held & (1u << a)) {
+          gs.pin_impulse[j][a] -= sh.mass[j] * dv[a];  // the pin holds it against dv too
+          dv[a] = 0;
+        }
       sh.v[j] += dv;
       sh.x[j] += dt * dv;
       gs.contact->C[j] += c_scale * B;

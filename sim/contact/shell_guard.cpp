@@ -196,9 +196,12 @@ std::size_t ShellGuard::impact_zones(double tol) {
       const std::size_t r = find(i);
       for (int a = 0; a < 3; ++a) {
         if (inv_mass_[i][a] == 0) continue;  // held: keeps its prescribed value
-        if (held[r][a] >= 0)
-          v_[i][a] = v_[static_cast<std::size_t>(held[r][a])][a];
-        else if (mass[r][a] > 0)
+        if (held[r][a] >= 0) {
+          const auto h = static_cast<std::size_t>(held[r][a]);
+          if (!held_v_.empty())  // the pin's impulse to bring the point to its velocity
+            pin_work_ += (v_[h][a] - v_[i][a]) / inv_mass_[i][a] * held_v_[h][a];
+          v_[i][a] = v_[h][a];
+        } else if (mass[r][a] > 0)
           v_[i][a] = mom[r][a] / mass[r][a];
       }
     }
@@ -267,6 +270,12 @@ void ShellGuard::load_points(const std::vector<GridShell>& shells,
   v_end_.resize(np);
   inv_mass_.resize(np);
   x0_.resize(np);
+  held_v_.clear();
+  pin_work_ = 0;
+  bool any_held = false;
+  for (const GridShell& g : shells)
+    for (const std::uint8_t h : g.held) any_held = any_held || h != 0;
+  if (any_held) held_v_.assign(np, Vec3d::Zero());
   for (std::size_t s = 0; s < shells.size(); ++s) {
     const ShellObject& sh = *shells[s].shell;
     parallel_for_each(
@@ -277,7 +286,10 @@ void ShellGuard::load_points(const std::vector<GridShell>& shells,
           v_[g] = v_end_[g] = (to_d(sh.x[j]) - x0_[g]) / dt;
           const double im = sh.mass[j] > 0 ? 1.0 / static_cast<double>(sh.mass[j]) : 0.0;
           const std::uint8_t held = j < shells[s].held.size() ? shells[s].held[j] : 0;
-          for (int a = 0; a < 3; ++a) inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
+          for (int a = 0; a < 3; ++a) {
+            inv_mass_[g][a] = (held & (1u << a)) ? 0.0 : im;
+            if (any_held && (held & (1u << a)) && im > 0) held_v_[g][a] = v_[g][a];
+          }
         },
         serial_);
   }
@@ -306,6 +318,7 @@ void ShellGuard::load_bulk(const GuardBulk& bulk, double dt) {
   const std::size_t np = point_offset_.back(), nbk = bulk_idx_.size();
   v_.resize(np + nbk);
   inv_mass_.resize(np + nbk);
+  if (!held_v_.empty()) held_v_.resize(np + nbk, Vec3d::Zero());
   bulk_x0_.resize(nbk);
   for (std::size_t k = 0; k < nbk; ++k) {
     const std::size_t p = bulk_idx_[k];
@@ -388,6 +401,7 @@ int ShellGuard::solve_pairs(double tol) {
       for (std::size_t i = p.begin; i < p.end; ++i) {
         const Entry& en = entries_[i];
         v_[en.point] += (en.w * dl) * p.n.cwiseProduct(inv_mass_[en.point]);
+        if (!held_v_.empty()) pin_work_ -= (en.w * dl) * p.n.dot(held_v_[en.point]);
       }
       change = std::max(change, std::abs(dl) * p.denom);
     }
@@ -416,6 +430,7 @@ void ShellGuard::apply_friction() {
     for (std::size_t i = p.begin; i < p.end; ++i) {
       const Entry& en = entries_[i];
       v_[en.point] -= (en.w * j) * t.cwiseProduct(inv_mass_[en.point]);
+      if (!held_v_.empty()) pin_work_ += (en.w * j) * t.dot(held_v_[en.point]);
     }
   }
 }
@@ -510,6 +525,7 @@ ShellGuardStats ShellGuard::apply(std::vector<GridShell>& shells,
   for (const Pair& p : pairs_)
     if (p.target - rate(p) > tol) ++st.unresolved;
   if (st.impulses == 0 && st.zoned == 0) return st;
+  st.pin_work = pin_work_;
   write_back(shells, ps, dt);
   return st;
 }

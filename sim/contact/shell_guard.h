@@ -72,6 +72,7 @@ struct ShellGuardStats {
   std::size_t zoned = 0;       ///< points moved as rigid impact zones (Gauss-Seidel fell short)
   std::size_t unresolved = 0;  ///< pairs still closing faster than allowed at the end
   int sweeps = 0;              ///< Gauss-Seidel sweeps taken
+  double pin_work = 0;         ///< the pins' work through the points they hold [J]
 };
 
 class ShellGuard {
@@ -209,6 +210,10 @@ class ShellGuard {
   std::vector<Vec3d> v_end_;     ///< (x - x^n) / dt before the guard
   std::vector<Vec3d> v_;         ///< control velocities (double) being corrected
   std::vector<Vec3d> inv_mass_;  ///< per control point and component
+  /// Per point: the pin's velocity on its held components, 0 elsewhere (empty when no
+  /// pin holds a point this pass); a held component's share of an impulse is the pin's.
+  std::vector<Vec3d> held_v_;
+  double pin_work_ = 0;  ///< the pins' work through the held points this pass [J]
   std::vector<Eigen::Vector3i> all_tris_;
   std::vector<Vec3d> edge_tri_pos_;
   std::vector<Eigen::Vector3i> all_edges_;  ///< edges as degenerate triangles (a, b, b)

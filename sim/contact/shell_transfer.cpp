@@ -53,24 +53,52 @@ void ShellPointTable::velocities(const std::vector<GridShell>& shells,
   out.resize(size(), Vec3::Zero());
 }
 
-void prescribe_pins(ShellObject& sh, double t, double dt, std::vector<std::uint8_t>& held) {
+double prescribe_pins(GridShell& g, double t, double dt) {
+  ShellObject& sh = *g.shell;
+  std::vector<std::uint8_t>& held = g.held;
   const ShellDesc& d = sh.desc();
   held.assign(sh.size(), 0);
-  if (d.pins.empty()) return;
+  g.pin_impulse.clear();
+  if (d.pins.empty()) return 0.0;
   std::vector<RigidPose> poses(d.pins.size());
   std::vector<char> released(d.pins.size());
+  bool holds = false;
   for (std::size_t p = 0; p < poses.size(); ++p) {
     poses[p] = keyframe_pose(d.pins[p].keyframes, t + dt);
     released[p] = d.pins[p].release_time && t >= *d.pins[p].release_time;
+    holds = holds || !released[p];
   }
+  if (!holds) return 0.0;
+  g.pin_impulse.assign(sh.size(), Vec3::Zero());
   const Real h = static_cast<Real>(dt);
+  double work = 0;
   for (std::size_t i = 0; i < sh.size(); ++i) {
     if (!sh.pin_mask[i] || released[sh.pin_of[i]]) continue;
     const Vec3 target = poses[sh.pin_of[i]].apply(sh.rest[i]).cast<Real>();
     held[i] = sh.pin_mask[i];
     for (int a = 0; a < 3; ++a)
-      if (held[i] & (1u << a)) sh.v[i][a] = (target[a] - sh.x[i][a]) / h;
+      if (held[i] & (1u << a)) {
+        const Real v0 = sh.v[i][a];
+        sh.v[i][a] = (target[a] - sh.x[i][a]) / h;
+        work += static_cast<double>(sh.mass[i]) * static_cast<double>(sh.v[i][a] - v0) *
+                static_cast<double>(sh.v[i][a]);
+      }
   }
+  return work;
+}
+
+double pin_transfer_work(const GridShell& g) {
+  if (g.pin_impulse.empty()) return 0.0;
+  const ShellObject& sh = *g.shell;
+  double work = 0;
+  for (std::size_t i = 0; i < g.pin_impulse.size(); ++i) {
+    const std::uint8_t held = g.held[i];
+    if (!held) continue;
+    for (int a = 0; a < 3; ++a)
+      if (held & (1u << a))
+        work += static_cast<double>(g.pin_impulse[i][a]) * static_cast<double>(sh.v[i][a]);
+  }
+  return work;
 }
 
 void shell_p2g_block(const SparseGrid& grid, const ShellPointTable& table,

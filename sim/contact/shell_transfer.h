@@ -35,6 +35,10 @@ struct GridShell {
   ShellContact* contact = nullptr;
   std::vector<Vec3> force;         ///< control-point forces this step (no gravity) [N]
   std::vector<std::uint8_t> held;  ///< per control point: components prescribed by pins
+  /// Per control point, while a pin holds one: the pins' impulse on its held components
+  /// over the step's transfer (what the grid would have given them, made up to the pin's
+  /// velocity) [N s]; empty while no pin holds.
+  std::vector<Vec3> pin_impulse;
 };
 
 /// The shell points binned in front of the bulk particles: all control points of all
@@ -63,9 +67,14 @@ class ShellPointTable {
   bool single_ = false;  ///< one shell
 };
 
-/// Sets the velocity of pinned components to the pin's motion over [t, t + dt] and
-/// records them in `held` (released pins hold nothing).
-void prescribe_pins(ShellObject& sh, double t, double dt, std::vector<std::uint8_t>& held);
+/// Sets the velocity of pinned components to the pin's motion over [t, t + dt], records
+/// them in g.held (released pins hold nothing) and zeroes g.pin_impulse for them. Returns
+/// the pins' work in changing those velocities, m (v_new - v_old) . v_new [J].
+double prescribe_pins(GridShell& g, double t, double dt);
+
+/// The pins' work over a step's transfer, sum over held components of the impulse in
+/// g.pin_impulse times the pin's velocity [J].
+double pin_transfer_work(const GridShell& g);
 
 /// A grid node's fold heights (shell_folds.cpp): the mass of one shell's control points
 /// there and the least and greatest height of the node over their tangent planes, in

@@ -97,6 +97,8 @@ GridShellTerms::GridShellTerms(const SparseGrid& grid, const ShellPointTable& ta
     S.v.assign(n, Vec3d::Zero());
     sh.external_forces(Vec3d::Zero(), S.x0, S.fext);
     sh.pin_targets(t, dt, S.held, S.target);
+    if (std::any_of(S.held.begin(), S.held.end(), [](std::uint8_t h) { return h != 0; }))
+      S.held_grad.assign(n, Vec3d::Zero());
     S.damping = sh.material().damping;
     S.membrane = sh.material().youngs_modulus * sh.material().thickness;
     Eigen::AlignedBox<double, 3> box;
@@ -232,10 +234,14 @@ double GridShellTerms::evaluate(bool grad) {
     for (std::size_t p = 0; p < ns; ++p) scatter_tangential(c, p, G[p], 1.0, S.dX);
     for (std::size_t j = 0; j < n; ++j) {
       const double m = static_cast<double>(sh.mass[j]);
-      for (int a = 0; a < 3; ++a)
-        S.dX[j][a] = (S.held[j] & (1u << a))
-                         ? 0.0
-                         : S.dX[j][a] - S.f[j][a] + S.damping * m * S.v[j][a] - S.fext[j][a];
+      for (int a = 0; a < 3; ++a) {
+        if (S.held[j] & (1u << a)) {
+          S.held_grad[j][a] = S.dX[j][a] - S.f[j][a];
+          S.dX[j][a] = 0.0;
+        } else {
+          S.dX[j][a] = S.dX[j][a] - S.f[j][a] + S.damping * m * S.v[j][a] - S.fext[j][a];
+        }
+      }
     }
   }
   return e;
@@ -259,6 +265,15 @@ double GridShellTerms::collider_work() const {
   double w = 0;
   for (const Shell& S : sh_)
     shellmpm::collider_penalty(penalty_input(S), S.X, nullptr, nullptr, &w);
+  return w;
+}
+
+double GridShellTerms::pin_work() const {
+  double w = 0;
+  for (const Shell& S : sh_)
+    for (std::size_t j = 0; j < S.held_grad.size(); ++j)
+      for (int a = 0; a < 3; ++a)
+        if (S.held[j] & (1u << a)) w += dt_ * S.held_grad[j][a] * S.v[j][a];
   return w;
 }
 

@@ -70,6 +70,10 @@ class GridShellTerms {
   /// The moving colliders' work on the control points over the step through the penalty,
   /// at the positions of the last evaluation [J] (collider_penalty.h).
   double collider_work() const;
+  /// The pins' work over the step in holding their components against the shells' forces
+  /// at the last gradient evaluation: dt dE/dX . v on each held component [J]. (The rest
+  /// of their impulse, against the nodes' motion, is G2P's: pin_transfer_work.)
+  double pin_work() const;
   /// The shells' own velocities at shared nodes (field_slots.h; null: none): a control
   /// point reads slot k's velocity (*slot_vel)[k] at a node of slot_of, and adds its
   /// offset. The objective's unknowns are then the nodes' 3 N_nodes components followed by
@@ -121,6 +125,9 @@ class GridShellTerms {
     std::vector<Vec3d> x0, X, v, f, fext, dX;  ///< start, moved, velocity, forces, loads, dE/dX
     std::vector<std::uint8_t> held;
     std::vector<Vec3d> target;
+    /// dE/dX on the held components at the last gradient evaluation (what the pins hold
+    /// them against); empty when nothing is held.
+    std::vector<Vec3d> held_grad;
     double damping = 0;
     double length = 1;
     double membrane = 0;  ///< E h [N/m]

@@ -107,13 +107,14 @@ class GridObjective final : public ImplicitObjective {
   /// stage's rule, with the constraint's impulse for the approach it stops): the normal
   /// impulse per unit mass the constraint applies at the solution u, j = (g . n) / m
   /// from the unprojected gradient, removes up to friction * j of the tangential
-  /// velocity relative to the collider. Returns the moving colliders' work over the step
-  /// (energy_audit.h): each constrained node's impulse, g plus the friction's, times the
-  /// collider's velocity there, plus the penalty's on shell control points.
+  /// velocity relative to the collider. Returns the moving colliders' and pins' work over
+  /// the step (energy_audit.h): each constrained node's impulse, g plus the friction's,
+  /// times the collider's velocity there, plus the penalty's on shell control points and
+  /// the pins' against the shells' forces on the components they hold.
   double apply_friction(VecXd& u) {
     VecXd g;
     raw_gradient(u, g);
-    double work = in_.shells ? in_.shells->collider_work() : 0.0;
+    double work = in_.shells ? in_.shells->collider_work() + in_.shells->pin_work() : 0.0;
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
       if (sticky_of_[i] >= 0) {
         const Collider& col = (*in_.colliders)[sticky_of_[i]];

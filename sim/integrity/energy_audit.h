@@ -17,7 +17,10 @@
 // - through the projection of points out of colliders, plus the potential energy it
 //   moves them by and, for a shell a moving collider moved, the change of what it
 //   stores;
-// and the kinetic and potential energy of emitted particles.
+// the kinetic and potential energy of emitted particles; and the moving pins' work, their
+// impulse on the components they hold (what the step's forces, the grid, the implicit
+// solve and the shell guard would have given them, made up to the pin's motion) times the
+// pin's velocity.
 // Backward Euler, APIC/MLS transfers, the return mappings of sand, snow and contact,
 // inelastic contact and damping only remove energy, so
 //   excess = (E_end - E_start) + dissipated - supplied
@@ -27,8 +30,8 @@
 // times the energy of lifting all mass by one cell: a warning by default
 // (shot.on_energy_gain), since the paper's contact model can also turn the compression a
 // step reads across a contact into work the audit cannot trace to its source.
-// A frame is not judged where an input is not measured at all: pressure loads, point
-// loads and pins that move do work the audit does not count.
+// A frame is not judged where an input is not measured at all: pressure loads and point
+// loads do work the audit does not count.
 #pragma once
 #include <string>
 #include <vector>

@@ -250,7 +250,7 @@ void ShellObject::pin_targets(double t, double dt, std::vector<std::uint8_t>& he
   }
 }
 
-void ShellObject::integrate(const std::vector<Vec3>& f, double t, double dt, bool serial) {
+double ShellObject::integrate(const std::vector<Vec3>& f, double t, double dt, bool serial) {
   const Real h = static_cast<Real>(dt);
   const Real damp = Real(1) / Real(1 + dt * mat_.damping);
   std::vector<RigidPose> poses(desc_.pins.size());
@@ -259,20 +259,24 @@ void ShellObject::integrate(const std::vector<Vec3>& f, double t, double dt, boo
     poses[p] = keyframe_pose(desc_.pins[p].keyframes, t + dt);
     released[p] = desc_.pins[p].release_time && t >= *desc_.pins[p].release_time;
   }
-  parallel_for(
-      x.size(), 4096,
-      [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) {
-          if (mass[i] > 0) v[i] = damp * (v[i] + (h / mass[i]) * f[i]);
-          if (pin_mask[i] && !released[pin_of[i]]) {
-            const Vec3 target = poses[pin_of[i]].apply(rest[i]).cast<Real>();
-            for (int a = 0; a < 3; ++a)
-              if (pin_mask[i] & (1u << a)) v[i][a] = (target[a] - x[i][a]) / h;
+  return ordered_reduce_chunks(x.size(), 4096, serial, 0.0, [&](std::size_t b, std::size_t e) {
+    double work = 0;  // the pins': their impulse on held components times the pin's velocity
+    for (std::size_t i = b; i < e; ++i) {
+      if (mass[i] > 0) v[i] = damp * (v[i] + (h / mass[i]) * f[i]);
+      if (pin_mask[i] && !released[pin_of[i]]) {
+        const Vec3 target = poses[pin_of[i]].apply(rest[i]).cast<Real>();
+        for (int a = 0; a < 3; ++a)
+          if (pin_mask[i] & (1u << a)) {
+            const Real free = v[i][a];
+            v[i][a] = (target[a] - x[i][a]) / h;
+            work += static_cast<double>(mass[i]) * static_cast<double>(v[i][a] - free) *
+                    static_cast<double>(v[i][a]);
           }
-          x[i] += h * v[i];
-        }
-      },
-      serial);
+      }
+      x[i] += h * v[i];
+    }
+    return work;
+  });
 }
 
 double ShellObject::project_plasticity(bool serial) {

@@ -65,8 +65,9 @@ class ShellObject {
   /// holds (0 once its pin is released at t), and target[i], where its pin puts it at t + dt.
   void pin_targets(double t, double dt, std::vector<std::uint8_t>& held,
                    std::vector<Vec3d>& target) const;
-  /// One symplectic Euler step with the forces f: damping, pins at time t + dt.
-  void integrate(const std::vector<Vec3>& f, double t, double dt, bool serial);
+  /// One symplectic Euler step with the forces f: damping, pins at time t + dt. Returns
+  /// the pins' work, their impulse on the held components times the pin's velocity [J].
+  double integrate(const std::vector<Vec3>& f, double t, double dt, bool serial);
   /// Denting return mapping; returns plastic work [J]. No-op without a yield stress.
   double project_plasticity(bool serial);
   bool has_denting() const { return mat_.yield_stress > 0; }

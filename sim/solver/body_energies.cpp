@@ -67,8 +67,6 @@ std::string energy_unjudged_reason(const Scene& scene) {
   for (const ShellDesc& s : scene.shells) {
     if (s.pressure != 0) return "shell '" + s.name + "' has a pressure load";
     if (!s.point_loads.empty()) return "shell '" + s.name + "' has point loads";
-    for (const PinDesc& p : s.pins)
-      if (p.keyframes.size() > 1) return "shell '" + s.name + "' has a moving pin";
   }
   return "";
 }

@@ -15,8 +15,8 @@ std::vector<BodyEnergy> body_energies(const StepContext& c);
 /// What shell i stores now: membrane, bending and its contact particles' energy [J].
 double shell_stored_energy(const StepContext& c, std::size_t i);
 
-/// Why the scene's frames cannot be audited (an input the audit does not measure: moving
-/// pins, pressure, point loads), or empty.
+/// Why the scene's frames cannot be audited (an input the audit does not measure:
+/// pressure, point loads), or empty.
 std::string energy_unjudged_reason(const Scene& scene);
 
 }  // namespace shellmpm

@@ -13,7 +13,7 @@ void ContactForcesStage::run(StepContext& c) {
   for (std::size_t i = 0; i < c.shells.size(); ++i) {
     if (!c.contacts[i]) continue;
     GridShell& g = c.grid_shells[k++];
-    prescribe_pins(*g.shell, c.time, c.dt, g.held);
+    c.energy_supplied += prescribe_pins(g, c.time, c.dt);
     if (c.scene.shot.integrator == Integrator::Implicit) {
       // The forces are part of the implicit grid solve: P2G transfers momentum only.
       g.contact->update_positions(g.shell->x.data(), c.opt.serial);

@@ -30,6 +30,7 @@ void G2pStage::run(StepContext& c) {
   }
   grid_to_particles(c.particles, c.grid, tp);
   if (fields) c.shell_fields.after_g2p(c.grid_shells, dt, c.opt.serial);
+  for (const GridShell& g : c.grid_shells) c.energy_supplied += pin_transfer_work(g);
   c.clamp_to_domain();
 }
 

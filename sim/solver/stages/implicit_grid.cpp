@@ -127,7 +127,7 @@ void ImplicitGridStage::run(StepContext& c) {
     cap_ = std::max(2 * cap_, 2 * dt);  // grows from the cap, not from a short step
   c.dt = dt;
   // Pinned control points: their velocity over the step actually taken.
-  for (GridShell& g : c.grid_shells) prescribe_pins(*g.shell, c.time, dt, g.held);
+  for (GridShell& g : c.grid_shells) c.energy_supplied += prescribe_pins(g, c.time, dt);
   c.apply_walls();
 }
 

@@ -83,6 +83,7 @@ void ShellGuardStage::run(StepContext& c) {
     bulk.epoch = c.particle_epoch;
   }
   const ShellGuardStats st = guard_.apply(c.grid_shells, c.shell_x_start, bulk, c.dt);
+  c.energy_supplied += st.pin_work;
   ShellGuardStats& f = c.guard_frame;
   f.pairs = std::max(f.pairs, st.pairs);
   f.impulses += st.impulses;

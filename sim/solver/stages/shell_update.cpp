@@ -10,7 +10,8 @@ bool ShellUpdateStage::needed(const Scene& s) {
 
 void ShellUpdateStage::run(StepContext& c) {
   for (std::size_t i = 0; i < c.shells.size(); ++i)
-    if (!c.contacts[i]) c.shells[i]->integrate(c.shell_forces[i], c.time, c.dt, c.opt.serial);
+    if (!c.contacts[i])
+      c.energy_supplied += c.shells[i]->integrate(c.shell_forces[i], c.time, c.dt, c.opt.serial);
 }
 
 }  // namespace shellmpm

@@ -1,7 +1,8 @@
 // The shell guard (sim/contact/shell_guard.h) on driven states with known answers: two
-// sheets driven through each other, bulk particles fired at a sheet, a pinned sheet, and
-// the claim that the candidate lists never change a result. Each step stands in for G2P:
-// velocities are set to the drive, x += dt v, then the guard runs.
+// sheets driven through each other, bulk particles fired at a sheet, a pinned sheet (and
+// the work its pin does), and the claim that the candidate lists never change a result.
+// Each step stands in for G2P: velocities are set to the drive, x += dt v, then the guard
+// runs.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -144,11 +145,33 @@ TEST_CASE("shell guard: a pinned sheet holds and keeps its prescribed motion", "
   gs[0].held.assign(sh[0]->size(), 7);  // all of sheet 0 prescribed
   ShellGuard guard;
   guard.setup(gs, kGap);
+  std::size_t impulses = 0;
   for (int step = 0; step < 15; ++step) {
     drive(sh, {Vec3(0, 0.1f, 0), Vec3(0, -2.0f, 0)});
-    guard.apply(gs, GuardBulk{}, kDt);
+    Vec3d p0 = Vec3d::Zero();
+    double k0 = 0;
+    for (std::size_t j = 0; j < sh[1]->size(); ++j) {
+      const Vec3d v = sh[1]->v[j].cast<double>();
+      p0 += static_cast<double>(sh[1]->mass[j]) * v;
+      k0 += 0.5 * static_cast<double>(sh[1]->mass[j]) * v.squaredNorm();
+    }
+    const ShellGuardStats st = guard.apply(gs, GuardBulk{}, kDt);
+    impulses += st.impulses;
     for (const Vec3& v : sh[0]->v) REQUIRE(v == Vec3(0, 0.1f, 0));
+    // Every impulse the free sheet took came through the pinned one, so the pins' work is
+    // that momentum times the pin's velocity, and it pays for the kinetic energy gained.
+    Vec3d p1 = Vec3d::Zero();
+    double k1 = 0;
+    for (std::size_t j = 0; j < sh[1]->size(); ++j) {
+      const Vec3d v = sh[1]->v[j].cast<double>();
+      p1 += static_cast<double>(sh[1]->mass[j]) * v;
+      k1 += 0.5 * static_cast<double>(sh[1]->mass[j]) * v.squaredNorm();
+    }
+    const double work = (p1 - p0).dot(Vec3d(0, 0.1, 0));
+    CHECK(st.pin_work == Approx(work).margin(1e-9));
+    CHECK(k1 - k0 <= st.pin_work + 1e-9);
   }
+  CHECK(impulses > 0);
   CHECK(min_distance(*sh[1], *sh[0]) > 0.9 * kGap);
   CHECK(mean_y(*sh[1]) > mean_y(*sh[0]));
 }
