@@ -277,6 +277,17 @@ double GridShellTerms::pin_work() const {
   return w;
 }
 
+double GridShellTerms::load_work() const {
+  double w = 0;
+  for (const Shell& S : sh_) {
+    if (!S.gs->shell->has_loads()) continue;
+    for (std::size_t j = 0; j < S.X.size(); ++j)
+      for (int a = 0; a < 3; ++a)
+        if (!(S.held[j] & (1u << a))) w += S.fext[j][a] * (S.X[j][a] - S.x0[j][a]);
+  }
+  return w;
+}
+
 double GridShellTerms::energy(const std::vector<PadD>& vel) {
   move(vel);
   advance_sites(vel);

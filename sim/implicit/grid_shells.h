@@ -74,6 +74,9 @@ class GridShellTerms {
   /// at the last gradient evaluation: dt dE/dX . v on each held component [J]. (The rest
   /// of their impulse, against the nodes' motion, is G2P's: pin_transfer_work.)
   double pin_work() const;
+  /// The pressure's and point loads' work on the free components over the step, to the
+  /// positions of the last evaluation [J] (a held component's load is the pin's).
+  double load_work() const;
   /// The shells' own velocities at shared nodes (field_slots.h; null: none): a control
   /// point reads slot k's velocity (*slot_vel)[k] at a node of slot_of, and adds its
   /// offset. The objective's unknowns are then the nodes' 3 N_nodes components followed by

@@ -110,11 +110,14 @@ class GridObjective final : public ImplicitObjective {
   /// velocity relative to the collider. Returns the moving colliders' and pins' work over
   /// the step (energy_audit.h): each constrained node's impulse, g plus the friction's,
   /// times the collider's velocity there, plus the penalty's on shell control points and
-  /// the pins' against the shells' forces on the components they hold.
+  /// the pins' against the shells' forces on the components they hold, and the shells'
+  /// loads'.
   double apply_friction(VecXd& u) {
     VecXd g;
     raw_gradient(u, g);
-    double work = in_.shells ? in_.shells->collider_work() + in_.shells->pin_work() : 0.0;
+    double work =
+        in_.shells ? in_.shells->collider_work() + in_.shells->pin_work() + in_.shells->load_work()
+                   : 0.0;
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
       if (sticky_of_[i] >= 0) {
         const Collider& col = (*in_.colliders)[sticky_of_[i]];

@@ -33,6 +33,7 @@ class ShellObjective final : public ImplicitObjective {
       xb_[i] = x0_[i] + dt * (1 - theta) * sh.v[i].cast<double>();
     }
     sh.external_forces(gravity, x0_, fext_);
+    loads_ = sh.load_forces();
     std::vector<Vec3d> target;
     sh.pin_targets(t, dt, held_, target);
     u0_.resize(3 * n_);
@@ -108,6 +109,14 @@ class ShellObjective final : public ImplicitObjective {
   void gradient(const VecXd& u, VecXd& g) override {
     full_gradient(u, g);
     project(g);
+  }
+
+  /// The pressure's and point loads' work over the step to x: their force at the step's
+  /// start times the control points' displacement.
+  double load_work(const std::vector<Vec3d>& x) const {
+    double w = 0;
+    for (std::size_t i = 0; i < loads_.size(); ++i) w += loads_[i].dot(x[i] - x0_[i]);
+    return w;
   }
 
   /// The pins' work over the step at the solution u: at a held component the gradient
@@ -284,6 +293,7 @@ class ShellObjective final : public ImplicitObjective {
   std::shared_ptr<const SparseMatrixD> K_;
   std::size_t n_ = 0;
   std::vector<Vec3d> x0_, xb_, fext_, f_, pen_grad_;
+  std::vector<Vec3d> loads_;  ///< pressure and point loads at x0_ (empty without)
   std::vector<std::uint8_t> held_;
   ColliderPenaltyInput penalty_;
   VecXd u0_, v0_, m_, kv_, explicit_;
@@ -347,7 +357,8 @@ NewtonReport ShellImplicitStep::step(ShellObject& sh, const Vec3d& gravity, doub
     }
     if (!rep.converged) return rep;
     const std::vector<Vec3d> x = obj.moved(u);
-    if (collider_work) *collider_work += theta * obj.collider_work(x) + obj.pin_work(u);
+    if (collider_work)
+      *collider_work += theta * obj.collider_work(x) + obj.pin_work(u) + obj.load_work(x);
     for (std::size_t i = 0; i < sh.size(); ++i) {
       sh.x[i] = x[i].cast<Real>();
       sh.v[i] = u.segment<3>(3 * i).cast<Real>();

@@ -47,9 +47,9 @@ class ShellImplicitStep {
 
   /// One step of sh from t to t + dt. On convergence writes sh.x and sh.v, and adds the
   /// moving colliders' work through the penalty to *collider_work (when given; the
-  /// penalty's impulse times their velocity, collider_penalty.h) and the moving pins'
-  /// (their impulse on the held components times the pin's velocity); otherwise leaves sh
-  /// as it was. The report says which.
+  /// penalty's impulse times their velocity, collider_penalty.h), the moving pins' (their
+  /// impulse on the held components times the pin's velocity) and the loads'; otherwise
+  /// leaves sh as it was. The report says which.
   NewtonReport step(ShellObject& sh, const Vec3d& gravity, double t, double dt, double theta,
                     const NewtonOptions& opt, ImplicitPreconditioner pre, bool serial,
                     const std::vector<Collider>* colliders = nullptr, std::uint64_t epoch = 0,

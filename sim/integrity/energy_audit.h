@@ -20,7 +20,8 @@
 // the kinetic and potential energy of emitted particles; and the moving pins' work, their
 // impulse on the components they hold (what the step's forces, the grid, the implicit
 // solve and the shell guard would have given them, made up to the pin's motion) times the
-// pin's velocity.
+// pin's velocity; and the pressure's and point loads' work, their force times the control
+// points' displacement.
 // Backward Euler, APIC/MLS transfers, the return mappings of sand, snow and contact,
 // inelastic contact and damping only remove energy, so
 //   excess = (E_end - E_start) + dissipated - supplied
@@ -30,8 +31,6 @@
 // times the energy of lifting all mass by one cell: a warning by default
 // (shot.on_energy_gain), since the paper's contact model can also turn the compression a
 // step reads across a contact into work the audit cannot trace to its source.
-// A frame is not judged where an input is not measured at all: pressure loads and point
-// loads do work the audit does not count.
 #pragma once
 #include <string>
 #include <vector>
@@ -59,7 +58,7 @@ struct BodyEnergy {
 
 /// What the audit found over one frame (energies in J).
 struct EnergyAudit {
-  bool judged = false;     ///< false: the first frame measured, or an input not counted
+  bool judged = false;     ///< false: the first frame measured, or the bodies changed
   std::string reason;      ///< why not judged (empty when judged)
   double start = 0;        ///< bodies' energy at the frame's start
   double end = 0;          ///< and at its end

@@ -196,6 +196,15 @@ void ShellObject::sync_double_kl(KirchhoffLoveShellT<double>& kl) const {
   kl.set_plastic_state(std::vector<double>(fp.begin(), fp.end()));
 }
 
+std::vector<Vec3d> ShellObject::load_forces() const {
+  std::vector<Vec3d> f;
+  if (!has_loads()) return f;
+  std::vector<Vec3d> at(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) at[i] = x[i].cast<double>();
+  external_forces(Vec3d::Zero(), at, f);
+  return f;
+}
+
 void ShellObject::external_forces(const Vec3d& gravity, const std::vector<Vec3d>& at,
                                   std::vector<Vec3d>& f) const {
   f.assign(at.size(), Vec3d::Zero());

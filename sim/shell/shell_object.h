@@ -71,6 +71,11 @@ class ShellObject {
   /// Denting return mapping; returns plastic work [J]. No-op without a yield stress.
   double project_plasticity(bool serial);
   bool has_denting() const { return mat_.yield_stress > 0; }
+  /// A pressure or point loads (external forces besides gravity).
+  bool has_loads() const { return desc_.pressure != 0 || !desc_.point_loads.empty(); }
+  /// The loads' forces at the control points now, without gravity [N] (empty without
+  /// loads).
+  std::vector<Vec3d> load_forces() const;
   /// The largest stable explicit step for this shell's membrane and bending stiffness [s].
   double stable_dt(double cfl) const;
   /// Kinetic energy [J].

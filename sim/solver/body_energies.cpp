@@ -63,12 +63,10 @@ double shell_stored_energy(const StepContext& c, std::size_t i) {
   return w;
 }
 
-std::string energy_unjudged_reason(const Scene& scene) {
-  for (const ShellDesc& s : scene.shells) {
-    if (s.pressure != 0) return "shell '" + s.name + "' has a pressure load";
-    if (!s.point_loads.empty()) return "shell '" + s.name + "' has point loads";
-  }
-  return "";
+double load_work(const std::vector<Vec3d>& f, const std::vector<Vec3>& v, double dt) {
+  double w = 0;
+  for (std::size_t j = 0; j < f.size(); ++j) w += f[j].dot(v[j].cast<double>());
+  return dt * w;
 }
 
 }  // namespace shellmpm

@@ -15,8 +15,8 @@ std::vector<BodyEnergy> body_energies(const StepContext& c);
 /// What shell i stores now: membrane, bending and its contact particles' energy [J].
 double shell_stored_energy(const StepContext& c, std::size_t i);
 
-/// Why the scene's frames cannot be audited (an input the audit does not measure:
-/// pressure, point loads), or empty.
-std::string energy_unjudged_reason(const Scene& scene);
+/// The work of loads f (per control point, constant over the step) on a shell whose
+/// control points moved by dt v over it: dt sum f . v [J] (0 when f is empty).
+double load_work(const std::vector<Vec3d>& f, const std::vector<Vec3>& v, double dt);
 
 }  // namespace shellmpm

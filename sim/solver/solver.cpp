@@ -38,7 +38,6 @@ Solver::Solver(const Scene& scene, SolverOptions opt) {
   }
   c_.shell_forces.resize(c_.shells.size());
   setup_contact();
-  energy_unjudged_ = energy_unjudged_reason(c_.scene);
   // The point order is read by the shells' transfers and the implicit solve; the bulk
   // transfers and the collider reach walk the blocks' runs.
   c_.grid.keep_order = !c_.grid_shells.empty() || s.integrator == Integrator::Implicit;
@@ -382,10 +381,6 @@ EnergyAudit Solver::audit_energy_frame(FrameStats& fs) {
   const double floor = kEnergyFloor * mass * kStandardGravity * c_.scene.shot.dx;
   EnergyAudit a = audit_energy(energy_start_, fs.bodies, dissipated, c_.energy_supplied, floor);
   energy_start_ = fs.bodies;
-  if (a.judged && !energy_unjudged_.empty()) {
-    a.judged = false;
-    a.reason = energy_unjudged_;
-  }
   if (a.failed() && c_.scene.shot.on_energy_gain != ShotSettings::OnEnergyGain::Ignore) {
     IntegrityEvent e;
     e.kind = IntegrityEvent::Kind::EnergyGain;

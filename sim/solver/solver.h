@@ -101,7 +101,6 @@ class Solver {
   std::vector<Slot> stages_;
   IntegrityMonitor integrity_;
   std::vector<BodyEnergy> energy_start_;  ///< empty: not measured yet
-  std::string energy_unjudged_;           ///< energy_unjudged_reason of the scene
 };
 
 }  // namespace shellmpm

@@ -66,7 +66,11 @@ struct StepContext {
   // GridShell (a swap) and adds the contact forces; g2p moves the contact shells'
   // control points; denting writes the shells' plastic state.
   std::vector<std::unique_ptr<ShellObject>> shells;
-  std::vector<std::vector<Vec3>> shell_forces;          ///< per shell [N]
+  std::vector<std::vector<Vec3>> shell_forces;  ///< per shell [N]
+  /// Per shell, the explicit step's pressure and point loads at its start (empty without
+  /// loads; shell_forces writes it): their work is the force times the control points'
+  /// displacement over the step (shell_update, g2p).
+  std::vector<std::vector<Vec3d>> shell_loads;
   std::vector<std::unique_ptr<ShellContact>> contacts;  ///< per shell; null: no contact
   std::vector<GridShell>
       grid_shells;                 ///< the shells with contact, their control points on the grid

@@ -1,5 +1,6 @@
 #include "sim/solver/stages/g2p.h"
 
+#include "sim/solver/body_energies.h"
 #include "sim/solver/stages/scene_rules.h"
 
 namespace shellmpm {
@@ -31,6 +32,10 @@ void G2pStage::run(StepContext& c) {
   grid_to_particles(c.particles, c.grid, tp);
   if (fields) c.shell_fields.after_g2p(c.grid_shells, dt, c.opt.serial);
   for (const GridShell& g : c.grid_shells) c.energy_supplied += pin_transfer_work(g);
+  // Explicit loads: the control points moved by dt v in g2p and after_g2p.
+  for (std::size_t i = 0, k = 0; i < c.shells.size() && i < c.shell_loads.size(); ++i)
+    if (c.contacts[i])
+      c.energy_supplied += load_work(c.shell_loads[i], c.grid_shells[k++].shell->v, c.dt);
   c.clamp_to_domain();
 }
 

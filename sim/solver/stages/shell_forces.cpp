@@ -13,8 +13,10 @@ bool ShellForcesStage::needed(const Scene& s) {
 
 void ShellForcesStage::run(StepContext& c) {
   const Vec3d zero = Vec3d::Zero();
+  c.shell_loads.resize(c.shells.size());
   for (std::size_t i = 0; i < c.shells.size(); ++i) {
     ShellObject& sh = *c.shells[i];
+    c.shell_loads[i] = sh.load_forces();
     if (!c.contacts[i]) {
       sh.forces(c.scene.shot.gravity, c.shell_forces[i], c.opt.serial);
       continue;
