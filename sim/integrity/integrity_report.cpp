@@ -46,7 +46,8 @@ std::vector<std::string> describe_integrity(const IntegrityReport& r, int frame,
         break;
       case IntegrityEvent::Kind::EnergyGain:
         os << "the bodies gained " << e.value
-           << " J of energy that neither gravity, the colliders nor the sources supplied ("
+           << " J of energy that neither gravity nor the colliders, pins, loads or sources "
+              "supplied ("
            << e.other << "; most in '" << e.object
            << "'): a blow-up, or contact pushing bodies apart (stats.json: energy; "
               "docs/integrity.md)";
