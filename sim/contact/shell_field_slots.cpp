@@ -15,11 +15,14 @@ void ShellFields::slots(const SparseGrid& combined, const std::vector<GridShell>
   out.control.resize(K);
   slot_r_.clear();
   slot_bits_.assign(ng, 0);
+  one_bits_.assign(ng, 0);
   slotted_ = true;
   if (!implicit_) return;
-  // The relative velocities at nodes under a collider gate (and at nodes with more bodies
-  // than a group code holds) stay the rule's for before_g2p, but are no offset the solve
-  // sees: set aside while the control points' offsets are summed.
+  // The relative velocities at nodes with more bodies than a group code holds stay the
+  // rule's for before_g2p, but are no offset the solve sees: set aside while the control
+  // points' offsets are summed. Nodes under a collider gate keep one velocity, the solve's
+  // (with the collider's constraint): the gate's per-body condition after the solve moved
+  // the bodies there by velocities the solve never saw.
   std::vector<std::pair<Vec3*, Vec3>> aside;
   std::vector<Body> bodies;
   // In the grid's order (the slots' order is the same for any thread count).
@@ -38,8 +41,14 @@ void ShellFields::slots(const SparseGrid& combined, const std::vector<GridShell>
         r_bulk_[g][n] = Vec3::Zero();
         continue;
       }
+      if (gate && gate->engaged(g, n)) {
+        for (Body& B : bodies) *B.r = Vec3::Zero();
+        r_bulk_[g][n] = Vec3::Zero();
+        one_bits_[g] |= std::uint64_t(1) << n;
+        continue;
+      }
       const bool fits = cnt + 1 <= std::size_t(kMaxGroupBodies);
-      if (!fits || (gate && gate->engaged(g, n))) {
+      if (!fits) {
         for (Body& B : bodies) {
           aside.emplace_back(B.r, *B.r);
           *B.r = Vec3::Zero();

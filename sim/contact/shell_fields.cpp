@@ -490,6 +490,7 @@ void ShellFields::p2g(const SparseGrid& combined, const std::vector<GridShell>& 
   dx_ = static_cast<Real>(combined.dx());
   slotted_ = false;
   slot_bits_.assign(ng, 0);
+  one_bits_.clear();
   if (implicit_) group_.resize(ng);
   const bool moments = bulk_particles && bulk_particles->size() > 0;
   if (moments) bulk_moments(combined, *bulk_particles, first_bulk, serial);
@@ -635,6 +636,7 @@ void ShellFields::before_g2p(SparseGrid& combined, const SkipFn& skip, bool seri
         for (int n = 0; n < kBlockNodes; ++n) {
           if (!(shared_[g] >> n & 1)) continue;
           if (slot_bits_[g] >> n & 1) continue;  // the implicit solve moved its bodies
+          if (g < one_bits_.size() && (one_bits_[g] >> n & 1)) continue;  // one velocity
           const Vec3i node = c + Vec3i(n >> 4, (n >> 2) & 3, n & 3);
           const bool one = skip && skip(node);
           if (!one && gate && gate->engaged(g, n)) {

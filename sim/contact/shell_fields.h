@@ -408,6 +408,8 @@ class ShellFields {
   bool slotted_ = false;                                       ///< slots() ran since the last p2g
   std::vector<std::array<std::uint64_t, kBlockNodes>> group_;  ///< per combined grid block
   std::vector<std::uint64_t> slot_bits_;  ///< per combined grid block: slotted nodes
+  /// Per combined grid block: nodes under a collider gate that slots() gave one velocity.
+  std::vector<std::uint64_t> one_bits_;
   /// The relative velocities of the bodies in slots, and their slot (take_solution).
   std::vector<std::pair<Vec3*, int>> slot_r_;
   /// The groups of the bodies at a slotted node, as slots() reads them: the rule's (code),

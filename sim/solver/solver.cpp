@@ -261,10 +261,12 @@ FrameStats Solver::advance_to(double t_end, const SubstepCallback& cb) {
     dt = remaining / steps;
     dt_seconds += std::chrono::duration<double>(clock::now() - d0).count();
     c_.dt = dt;
+    if (trace_.on()) trace_.begin(c_);
     for (Slot& st : stages_) {
       const auto t0 = clock::now();
       st.stage->run(c_);
       st.seconds += std::chrono::duration<double>(clock::now() - t0).count();
+      if (trace_.on()) trace_.after(c_, st.stage->name());
     }
     // An implicit stage may have taken a shorter step than asked (a retry at half the step).
     const bool shortened = c_.dt < dt;

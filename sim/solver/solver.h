@@ -12,6 +12,7 @@
 #include "sim/core/simulation_error.h"
 #include "sim/integrity/energy_audit.h"
 #include "sim/integrity/integrity_monitor.h"
+#include "sim/solver/energy_trace.h"
 #include "sim/solver/frame_stats.h"
 #include "sim/solver/stages/stage.h"
 #include "sim/solver/step_context.h"
@@ -100,6 +101,7 @@ class Solver {
   StepContext c_;
   std::vector<Slot> stages_;
   IntegrityMonitor integrity_;
+  EnergyTrace trace_;                     ///< SHELLMPM_ENERGY_TRACE (energy_trace.h)
   std::vector<BodyEnergy> energy_start_;  ///< empty: not measured yet
 };
 
