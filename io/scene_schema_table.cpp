@@ -145,6 +145,7 @@ std::vector<KeySpec> build_schema() {
       Spec("shot.shell_fields_in_solve", T::Bool)
           .to(&ShotSettings::shell_fields_in_solve)
           .def("false"),
+      Spec("shot.friction_in_solve", T::Bool).to(&ShotSettings::friction_in_solve).def("false"),
       Spec("shot.units", T::String).to(&ShotSettings::units).def("m").nonempty(),
       Spec("shot.on_integrity_failure", T::Enum)
           .to(&ShotSettings::on_integrity_failure)

@@ -494,7 +494,8 @@ void GridShellTerms::prepare(const std::vector<PadD>& vel, const SparseMatrixD& 
   // formed once.
   const bool first = Jall_.rows() == 0;
   joint(vel, minv.rows(), first ? &Jall_ : nullptr, K);
-  if (first) Sall_ = (Jall_ * minv * SparseMatrixD(Jall_.transpose())).pruned();
+  if (first || Sall_.rows() == 0)
+    Sall_ = (Jall_ * minv * SparseMatrixD(Jall_.transpose())).pruned();
   const SparseMatrixD& J = Jall_;
   const SparseMatrixD& S = Sall_;
   // Only the joint unknowns that reach a node and have stiffness enter J^T K J (K is

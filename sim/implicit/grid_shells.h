@@ -114,6 +114,12 @@ class GridShellTerms {
   /// apply (K^-1 + S~)^-1 as S~^-1 - S~^-1 (K + S~^-1)^-1 S~^-1: one factorisation of K's
   /// size and sparsity.
   void prepare(const std::vector<PadD>& vel, const SparseMatrixD& minv);
+  /// M^-1 changed within the step (friction's stiffness added at collider nodes,
+  /// grid_step.cpp): the next prepare forms S again.
+  void minv_changed() {
+    Sall_ = SparseMatrixD();
+    kept_.clear();
+  }
   /// Whether the last prepare kept the coupling exactly.
   bool exact() const { return exact_; }
   /// z = P^-1 r (after prepare).

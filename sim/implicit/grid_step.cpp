@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "sim/core/parallel.h"
+#include "sim/implicit/friction_potential.h"
 #include "sim/mpm/bspline.h"
 
 namespace shellmpm {
@@ -14,6 +15,11 @@ namespace {
 using Pad = PadD;
 
 constexpr int kRefreshExact = 3, kRefreshLumped = 10;
+/// Friction inside the solve: the solves with the normal impulses of the one before, and
+/// the tangential speed below which a node sticks elastically [m/s] (friction_potential.h;
+/// a node held by friction creeps at most this fast).
+constexpr int kFrictionLags = 1;
+constexpr double kFrictionSmoothing = 1e-3;
 
 /// A stencil node: offsets from the weights' base, padded-buffer index, weight.
 struct StencilNodeD {
@@ -95,6 +101,9 @@ class GridObjective final : public ImplicitObjective {
       const Vec3d du = u.segment<3>(3 * i) - vhat_.segment<3>(3 * i);
       e += m_[i] * (0.5 * du.squaredNorm() - dt_ * in_.gravity.dot(u.segment<3>(3 * i)));
     }
+    if (friction_on_)
+      for (std::size_t k = 0; k < fric_.size(); ++k)
+        e += fric_[k].energy(u.segment<3>(3 * fric_node_[k]));
     return e;
   }
 
@@ -103,16 +112,54 @@ class GridObjective final : public ImplicitObjective {
     project(g);
   }
 
-  /// Coulomb friction at the slip and separate collider nodes (the explicit collider
-  /// stage's rule, with the constraint's impulse for the approach it stops): the normal
-  /// impulse per unit mass the constraint applies at the solution u, j = (g . n) / m
-  /// from the unprojected gradient, removes up to friction * j of the tangential
-  /// velocity relative to the collider. Returns the moving colliders' and pins' work over
-  /// the step (energy_audit.h): each constrained node's impulse, g plus the friction's,
-  /// times the collider's velocity there, plus the penalty's on shell control points and
-  /// the pins' against the shells' forces on the components they hold, and the shells'
-  /// loads'.
-  double apply_friction(VecXd& u) {
+  /// Friction inside the solve (GridStepInput::friction_in_solve): Coulomb friction at
+  /// the slip and separate collider nodes as the lagged potential of friction_potential.h,
+  /// its bound friction * (g . n) from the constraint's normal impulse at u (g the
+  /// unprojected gradient without friction: m (u - v^n) - dt f = g). Returns whether any
+  /// node has friction; the next solve minimises with it.
+  bool lag_friction(const VecXd& u) {
+    friction_on_ = false;
+    VecXd g;
+    raw_gradient(u, g);
+    fric_.clear();
+    fric_node_.clear();
+    fric_h_.clear();
+    fric_of_.assign(static_cast<std::size_t>(m_.size()), -1);
+    for (Eigen::Index i = 0; i < m_.size(); ++i) {
+      if (collider_of_[i] < 0) continue;
+      const Collider& col = (*in_.colliders)[collider_of_[i]];
+      const double mu = col.desc().friction;
+      const double jn = g.segment<3>(3 * i).dot(normal_[i]);
+      if (!(mu > 0) || !(jn > 0)) continue;
+      LaggedFriction f;
+      f.n = normal_[i];
+      f.vc = col.velocity(position_[i]);
+      f.bound = mu * jn;
+      f.eps = kFrictionSmoothing;
+      fric_of_[static_cast<std::size_t>(i)] = static_cast<int>(fric_.size());
+      fric_.push_back(f);
+      fric_node_.push_back(i);
+      fric_h_.push_back(f.hessian(u.segment<3>(3 * i)));
+    }
+    friction_on_ = !fric_.empty();
+    // The preconditioner's M takes friction's Hessian at u, fixed for the solve (the
+    // shells' S = J M^-1 J^T is formed once per M).
+    if (friction_on_ && in_.shells) in_.shells->minv_changed();
+    return friction_on_;
+  }
+
+  /// Ends the step at the solution u. Without friction in the solve, Coulomb friction at
+  /// the slip and separate collider nodes (the explicit collider stage's rule, with the
+  /// constraint's impulse for the approach it stops): the normal impulse per unit mass
+  /// the constraint applies at u, j = (g . n) / m from the unprojected gradient, removes
+  /// up to friction * j of the tangential velocity relative to the collider. Returns the
+  /// moving colliders' and pins' work over the step (energy_audit.h): each constrained
+  /// node's impulse (g, which with friction in the solve includes friction's, plus the
+  /// friction applied here) times the collider's velocity there, plus the penalty's on
+  /// shell control points and the pins' against the shells' forces on the components they
+  /// hold, and the shells' loads'.
+  double finish(VecXd& u) {
+    friction_on_ = false;  // g: the constraints' impulse, friction's share included
     VecXd g;
     raw_gradient(u, g);
     double work =
@@ -125,9 +172,8 @@ class GridObjective final : public ImplicitObjective {
       }
       if (collider_of_[i] < 0) continue;
       const Collider& col = (*in_.colliders)[collider_of_[i]];
-      const double mu = col.desc().friction;
+      const double mu = in_.friction_in_solve ? 0.0 : col.desc().friction;
       const Vec3d& n = normal_[i];
-      // m (u - v^n) - dt f = g: the constraint's impulse is g, its normal part g . n.
       const double j = g.segment<3>(3 * i).dot(n) / m_[i];
       const Vec3d vc = col.velocity(position_[i]);
       const Vec3d before = u.segment<3>(3 * i);
@@ -160,6 +206,11 @@ class GridObjective final : public ImplicitObjective {
       g.segment<3>(3 * i) +=
           m_[i] * (u.segment<3>(3 * i) - vhat_.segment<3>(3 * i) - dt_ * in_.gravity);
     }
+    if (friction_on_)
+      for (std::size_t k = 0; k < fric_.size(); ++k) {
+        const Eigen::Index i = 3 * fric_node_[k];
+        g.segment<3>(i) += fric_[k].gradient(u.segment<3>(i));
+      }
   }
 
  public:
@@ -174,7 +225,11 @@ class GridObjective final : public ImplicitObjective {
   /// With shells: their part of the Hessian (grid_shells.h, prepare), or with
   /// block_jacobi its diagonal added to the nodes' own.
   void prepare_preconditioner(const VecXd& u) override {
-    if (!in_.shells) return;
+    if (!in_.shells) {
+      diag_ = base_diag_;
+      add_friction_diagonal();
+      return;
+    }
     scatter(u);
     if (in_.factorise) {
       projected_inverse_diagonal();
@@ -184,6 +239,7 @@ class GridObjective final : public ImplicitObjective {
     }
     diag_ = base_diag_;
     in_.shells->add_diagonal(vbuf_, diag_);
+    add_friction_diagonal();
   }
 
   /// Factorised shells: every kRefreshExact iterations with the exact coupling, every
@@ -395,6 +451,8 @@ class GridObjective final : public ImplicitObjective {
   /// constraints' projection (project: the slip normal's component removed, then the
   /// fixed components zeroed): the inverse of Pi D Pi^T on the directions CG moves in, so
   /// the shells' Woodbury preconditioner inverts the projected Hessian.
+  /// With friction in the solve, D's block at a node with friction adds friction's Hessian
+  /// where the lag was taken.
   void projected_inverse_diagonal() {
     std::vector<Eigen::Triplet<double>> t;
     for (Eigen::Index i = 0; i < m_.size(); ++i) {
@@ -405,14 +463,27 @@ class GridObjective final : public ImplicitObjective {
       if (n.squaredNorm() > 0) Pi -= (cut ? 1.0 / n.squaredNorm() : 1.0) * n * n.transpose();
       for (int a = 0; a < 3; ++a)
         if (fixed_[static_cast<std::size_t>(3 * i + a)]) Pi.row(a).setZero();
-      const Mat3d B =
-          Pi * base_diag_.segment<3>(3 * i).cwiseInverse().asDiagonal() * Pi.transpose();
+      const int k = friction_on_ ? fric_of_[static_cast<std::size_t>(i)] : -1;
+      const Mat3d Dinv =
+          k < 0 ? Mat3d(base_diag_.segment<3>(3 * i).cwiseInverse().asDiagonal())
+                : Mat3d((Mat3d(base_diag_.segment<3>(3 * i).asDiagonal()) + fric_h_[std::size_t(k)])
+                            .inverse());
+      const Mat3d B = Pi * Dinv * Pi.transpose();
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
           if (B(a, b) != 0) t.emplace_back(3 * i + a, 3 * i + b, B(a, b));
     }
     minv_.resize(size(), size());
     minv_.setFromTriplets(t.begin(), t.end());
+  }
+
+  /// Friction's Hessian diagonal where the lag was taken, added to diag_.
+  void add_friction_diagonal() {
+    if (!friction_on_) return;
+    for (std::size_t k = 0; k < fric_.size(); ++k) {
+      const Eigen::Index i = 3 * fric_node_[k];
+      diag_.segment<3>(i) += fric_h_[k].diagonal();
+    }
   }
 
   /// Jacobi diagonal m_i + dt^2 sum_p V_p c_p |grad w_ip|^2 (at F^n).
@@ -458,6 +529,13 @@ class GridObjective final : public ImplicitObjective {
   std::vector<int> collider_of_;  // the collider of that constraint (-1: none)
   std::vector<int> sticky_of_;    // the sticky collider holding the node (-1: none)
   std::vector<Vec3d> position_;   // the node's position where it has one
+  // Friction inside the solve (lag_friction): the nodes with friction, their terms, and
+  // each node's index among them (-1: none).
+  bool friction_on_ = false;
+  std::vector<LaggedFriction> fric_;
+  std::vector<Mat3d> fric_h_;  // their Hessians where the lag was taken (preconditioner)
+  std::vector<Eigen::Index> fric_node_;
+  std::vector<int> fric_of_;
   std::vector<Pad> vbuf_, fbuf_;
 };
 
@@ -474,7 +552,18 @@ NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const Newton
   VecXd u = obj.initial();
   NewtonReport rep = newton_minimise(obj, u, opt);
   if (!rep.converged) return rep;
-  const double work = obj.apply_friction(u);
+  // Friction inside the solve: solved again from u with the normal impulses u needed.
+  for (int lag = 0; in.friction_in_solve && lag < kFrictionLags && obj.lag_friction(u); ++lag) {
+    const NewtonReport again = newton_minimise(obj, u, opt);
+    rep.iterations += again.iterations;
+    rep.cg_iterations += again.cg_iterations;
+    rep.round_off_steps += again.round_off_steps;
+    rep.residual = again.residual;
+    rep.line_search_failed = again.line_search_failed;
+    rep.converged = again.converged;
+    if (!rep.converged) return rep;
+  }
+  const double work = obj.finish(u);
   if (in.collider_work) *in.collider_work = work;
   if (in.slot_out) {
     const std::size_t ns = in.slots ? in.slots->num_slots() : 0;

@@ -16,7 +16,8 @@
 // velocity, slip and separate (approaching) nodes keep the collider's normal velocity and
 // move freely along the surface. Coulomb friction follows the solve at those nodes, with
 // the normal impulse the constraint applied (the explicit collider stage takes it from the
-// approach speed, which the constraint has already stopped here).
+// approach speed, which the constraint has already stopped here), or is a term of the
+// objective (friction_in_solve).
 //
 // Shells in contact add their Kirchhoff-Love and contact energies at the moved control
 // points (grid_shells.h); the preconditioner then includes their tangent on the nodes they
@@ -72,6 +73,11 @@ struct GridStepInput {
   /// With shells: `factorised` factorises the tangent on the nodes the shells reach
   /// (Jacobi elsewhere); `block_jacobi` keeps its diagonal.
   bool factorise = true;
+  /// Coulomb friction at the slip and separate collider nodes inside the solve (the
+  /// lagged potential of friction_potential.h; the step is solved again with the normal
+  /// impulses its first solution needed), or after it (false: the velocities change by
+  /// the friction impulse after the solve).
+  bool friction_in_solve = false;
   /// On convergence (non-null): the moving colliders' work over the step [J]
   /// (energy_audit.h).
   double* collider_work = nullptr;

@@ -88,6 +88,9 @@ struct ShotSettings {
   /// Implicit grid step: the shells' own velocity fields at shared nodes as unknowns of
   /// the solve (field_slots.h), or added after it.
   bool shell_fields_in_solve = false;
+  /// Implicit grid step: Coulomb friction at the colliders inside the solve (a lagged
+  /// potential, the step solved again with the normal impulses), or after it.
+  bool friction_in_solve = false;
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
   enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;
