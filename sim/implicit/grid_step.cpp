@@ -20,6 +20,9 @@ constexpr int kRefreshExact = 3, kRefreshLumped = 10;
 /// a node held by friction creeps at most this fast).
 constexpr int kFrictionLags = 1;
 constexpr double kFrictionSmoothing = 1e-3;
+/// A solve that started from bounds within this share of those its solution needs (summed
+/// over the nodes) is not solved again (GridStepInput::friction_bounds).
+constexpr double kLagTolerance = 0.25;
 
 /// A stencil node: offsets from the weights' base, padded-buffer index, weight.
 struct StencilNodeD {
@@ -112,34 +115,59 @@ class GridObjective final : public ImplicitObjective {
     project(g);
   }
 
-  /// Friction inside the solve (GridStepInput::friction_in_solve): Coulomb friction at
-  /// the slip and separate collider nodes as the lagged potential of friction_potential.h,
-  /// its bound friction * (g . n) from the constraint's normal impulse at u (g the
-  /// unprojected gradient without friction: m (u - v^n) - dt f = g). Returns whether any
-  /// node has friction; the next solve minimises with it.
-  bool lag_friction(const VecXd& u) {
+  /// Friction inside the solve (GridStepInput::friction_in_solve): each slip or separate
+  /// collider node's Coulomb bound, friction * (g . n), from the constraint's normal
+  /// impulse at u (g the unprojected gradient without friction: m (u - v^n) - dt f = g);
+  /// 0 where it pulls or has no friction.
+  std::vector<double> friction_bounds(const VecXd& u) {
+    const bool on = friction_on_;
     friction_on_ = false;
     VecXd g;
     raw_gradient(u, g);
+    friction_on_ = on;
+    std::vector<double> b(static_cast<std::size_t>(nodes_), 0.0);
+    for (std::size_t i = 0; i < nodes_; ++i) {
+      if (collider_of_[i] < 0) continue;
+      const double mu = (*in_.colliders)[collider_of_[i]].desc().friction;
+      const double jn = g.segment<3>(3 * static_cast<Eigen::Index>(i)).dot(normal_[i]);
+      if (mu > 0 && jn > 0) b[i] = mu * jn;
+    }
+    return b;
+  }
+
+  /// Whether bounds b differ from those the last solve used by more than kLagTolerance
+  /// of their sum.
+  bool friction_moved(const std::vector<double>& b) const {
+    double diff = 0, sum = 0;
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      const int k = friction_on_ && i < fric_of_.size() ? fric_of_[i] : -1;
+      diff += std::abs(b[i] - (k < 0 ? 0.0 : fric_[std::size_t(k)].bound));
+      sum += b[i];
+    }
+    return diff > kLagTolerance * sum;
+  }
+
+  /// The lagged potential of friction_potential.h at the nodes with a bound in b (sized
+  /// by the nodes), its Hessian at u for the preconditioner. Returns whether any node has
+  /// friction; the next solve minimises with it.
+  bool set_friction(const std::vector<double>& b, const VecXd& u) {
     fric_.clear();
     fric_node_.clear();
     fric_h_.clear();
     fric_of_.assign(static_cast<std::size_t>(m_.size()), -1);
-    for (Eigen::Index i = 0; i < m_.size(); ++i) {
-      if (collider_of_[i] < 0) continue;
+    for (std::size_t i = 0; i < nodes_ && i < b.size(); ++i) {
+      if (collider_of_[i] < 0 || !(b[i] > 0)) continue;
       const Collider& col = (*in_.colliders)[collider_of_[i]];
-      const double mu = col.desc().friction;
-      const double jn = g.segment<3>(3 * i).dot(normal_[i]);
-      if (!(mu > 0) || !(jn > 0)) continue;
       LaggedFriction f;
       f.n = normal_[i];
       f.vc = col.velocity(position_[i]);
-      f.bound = mu * jn;
+      f.bound = b[i];
       f.eps = kFrictionSmoothing;
-      fric_of_[static_cast<std::size_t>(i)] = static_cast<int>(fric_.size());
+      const auto e = static_cast<Eigen::Index>(i);
+      fric_of_[i] = static_cast<int>(fric_.size());
       fric_.push_back(f);
-      fric_node_.push_back(i);
-      fric_h_.push_back(f.hessian(u.segment<3>(3 * i)));
+      fric_node_.push_back(e);
+      fric_h_.push_back(f.hessian(u.segment<3>(3 * e)));
     }
     friction_on_ = !fric_.empty();
     // The preconditioner's M takes friction's Hessian at u, fixed for the solve (the
@@ -550,10 +578,17 @@ std::unique_ptr<ImplicitObjective> grid_objective(const GridStepInput& in, doubl
 NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const NewtonOptions& opt) {
   GridObjective obj(in, dt);
   VecXd u = obj.initial();
+  std::vector<double>* seed = in.friction_in_solve ? in.friction_bounds : nullptr;
+  if (seed && !seed->empty()) obj.set_friction(*seed, u);
   NewtonReport rep = newton_minimise(obj, u, opt);
   if (!rep.converged) return rep;
-  // Friction inside the solve: solved again from u with the normal impulses u needed.
-  for (int lag = 0; in.friction_in_solve && lag < kFrictionLags && obj.lag_friction(u); ++lag) {
+  // Friction inside the solve: solved again from u with the normal impulses u needed,
+  // unless it started from nearly those.
+  for (int lag = 0; in.friction_in_solve; ++lag) {
+    std::vector<double> b = obj.friction_bounds(u);
+    const bool resolve = lag < kFrictionLags && obj.friction_moved(b) && obj.set_friction(b, u);
+    if (seed) seed->swap(b);
+    if (!resolve) break;
     const NewtonReport again = newton_minimise(obj, u, opt);
     rep.iterations += again.iterations;
     rep.cg_iterations += again.cg_iterations;

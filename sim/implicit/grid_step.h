@@ -78,6 +78,11 @@ struct GridStepInput {
   /// impulses its first solution needed), or after it (false: the velocities change by
   /// the friction impulse after the solve).
   bool friction_in_solve = false;
+  /// With friction in the solve (null: none): each node's Coulomb bound to start from
+  /// (empty: none; the step is solved without friction first), and on return those its
+  /// solution needs. A step solved again after its groups were joined starts from the
+  /// last solve's and is solved once more only where they moved by over a quarter.
+  std::vector<double>* friction_bounds = nullptr;
   /// On convergence (non-null): the moving colliders' work over the step [J]
   /// (energy_audit.h).
   double* collider_work = nullptr;

@@ -58,6 +58,8 @@ void ImplicitGridStage::run(StepContext& c) {
   std::vector<std::array<GridNode, kBlockNodes>> before;  // the grid as P2G left it
   std::vector<std::array<GridNode, kBlockNodes>> solved;  // the last solve's velocities
   int regroups = 0;
+  std::vector<double> friction_bounds;  // friction in the solve: the last solve's bounds
+  in.friction_bounds = &friction_bounds;
   const auto pose_slots = [&]() {
     ShellFields::SkipFn skip;
     ShellFields::ColliderGate gate;
@@ -106,6 +108,7 @@ void ImplicitGridStage::run(StepContext& c) {
       break;
     }
     in.start = nullptr;  // a shorter step starts afresh
+    friction_bounds.clear();
     retried = true;
     ++c.implicit_frame.retries;
     dt *= 0.5;
