@@ -125,14 +125,20 @@ class GridObjective final : public ImplicitObjective {
     VecXd g;
     raw_gradient(u, g);
     friction_on_ = on;
-    std::vector<double> b(static_cast<std::size_t>(nodes_), 0.0);
+    std::vector<double> b;
+    bounds_from(g, b);
+    return b;
+  }
+
+  /// The bounds of friction_bounds from that gradient g.
+  void bounds_from(const VecXd& g, std::vector<double>& b) const {
+    b.assign(nodes_, 0.0);
     for (std::size_t i = 0; i < nodes_; ++i) {
       if (collider_of_[i] < 0) continue;
       const double mu = (*in_.colliders)[collider_of_[i]].desc().friction;
       const double jn = g.segment<3>(3 * static_cast<Eigen::Index>(i)).dot(normal_[i]);
       if (mu > 0 && jn > 0) b[i] = mu * jn;
     }
-    return b;
   }
 
   /// Whether bounds b differ from those the last solve used by more than kLagTolerance
@@ -185,11 +191,12 @@ class GridObjective final : public ImplicitObjective {
   /// node's impulse (g, which with friction in the solve includes friction's, plus the
   /// friction applied here) times the collider's velocity there, plus the penalty's on
   /// shell control points and the pins' against the shells' forces on the components they
-  /// hold, and the shells' loads'.
-  double finish(VecXd& u) {
+  /// hold, and the shells' loads'. With `bounds`, also friction_bounds at u.
+  double finish(VecXd& u, std::vector<double>* bounds) {
     friction_on_ = false;  // g: the constraints' impulse, friction's share included
     VecXd g;
     raw_gradient(u, g);
+    if (bounds) bounds_from(g, *bounds);
     double work =
         in_.shells ? in_.shells->collider_work() + in_.shells->pin_work() + in_.shells->load_work()
                    : 0.0;
@@ -584,11 +591,9 @@ NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const Newton
   if (!rep.converged) return rep;
   // Friction inside the solve: solved again from u with the normal impulses u needed,
   // unless it started from nearly those.
-  for (int lag = 0; in.friction_in_solve; ++lag) {
-    std::vector<double> b = obj.friction_bounds(u);
-    const bool resolve = lag < kFrictionLags && obj.friction_moved(b) && obj.set_friction(b, u);
-    if (seed) seed->swap(b);
-    if (!resolve) break;
+  for (int lag = 0; in.friction_in_solve && lag < kFrictionLags; ++lag) {
+    const std::vector<double> b = obj.friction_bounds(u);
+    if (!obj.friction_moved(b) || !obj.set_friction(b, u)) break;
     const NewtonReport again = newton_minimise(obj, u, opt);
     rep.iterations += again.iterations;
     rep.cg_iterations += again.cg_iterations;
@@ -598,7 +603,7 @@ NewtonReport implicit_grid_step(const GridStepInput& in, double dt, const Newton
     rep.converged = again.converged;
     if (!rep.converged) return rep;
   }
-  const double work = obj.finish(u);
+  const double work = obj.finish(u, seed);  // and the bounds at u for a solve again
   if (in.collider_work) *in.collider_work = work;
   if (in.slot_out) {
     const std::size_t ns = in.slots ? in.slots->num_slots() : 0;

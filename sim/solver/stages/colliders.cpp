@@ -21,10 +21,9 @@ void CollidersStage::run(StepContext& c) {
   // and the control points' penalty are the colliders' conditions for the step: applied
   // again to the solved velocities they moved the nodes the solve left free (a plate
   // pressing a steel can put 3-7 J a step into its membrane that no force paid for,
-  // docs/implicit.md). Particles still leave the colliders by collider_particles.
-  if (c.scene.shot.integrator == Integrator::Implicit && c.scene.shot.shell_fields_in_solve &&
-      c.shell_fields.has_slots())
-    return;
+  // docs/implicit.md). Particles still leave the colliders by collider_particles. (Slots
+  // exist only after an implicit step with the fields in the solve.)
+  if (c.shell_fields.has_slots()) return;
   const double dx = c.grid.dx();
   // The work of the moving colliders (energy_audit.h): per block, summed in block order.
   work_.assign(c.grid.num_grid_blocks(), 0.0);
