@@ -146,6 +146,12 @@ std::vector<KeySpec> build_schema() {
           .to(&ShotSettings::shell_fields_in_solve)
           .def("false"),
       Spec("shot.friction_in_solve", T::Bool).to(&ShotSettings::friction_in_solve).def("false"),
+      Spec("shot.friction_stick_speed", T::Number)
+          .to(&ShotSettings::friction_stick_speed)
+          .def("1e-3")
+          .unit("m/s")
+          .gt(0)
+          .le(1),
       Spec("shot.units", T::String).to(&ShotSettings::units).def("m").nonempty(),
       Spec("shot.on_integrity_failure", T::Enum)
           .to(&ShotSettings::on_integrity_failure)

@@ -15,11 +15,8 @@ namespace {
 using Pad = PadD;
 
 constexpr int kRefreshExact = 3, kRefreshLumped = 10;
-/// Friction inside the solve: the solves with the normal impulses of the one before, and
-/// the tangential speed below which a node sticks elastically [m/s] (friction_potential.h;
-/// a node held by friction creeps at most this fast).
+/// Friction inside the solve: the solves with the normal impulses of the one before.
 constexpr int kFrictionLags = 1;
-constexpr double kFrictionSmoothing = 1e-3;
 /// A solve that started from bounds within this share of those its solution needs (summed
 /// over the nodes) is not solved again (GridStepInput::friction_bounds).
 constexpr double kLagTolerance = 0.25;
@@ -168,7 +165,7 @@ class GridObjective final : public ImplicitObjective {
       f.n = normal_[i];
       f.vc = col.velocity(position_[i]);
       f.bound = b[i];
-      f.eps = kFrictionSmoothing;
+      f.eps = in_.friction_stick_speed;
       const auto e = static_cast<Eigen::Index>(i);
       fric_of_[i] = static_cast<int>(fric_.size());
       fric_.push_back(f);

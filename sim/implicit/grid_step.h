@@ -78,6 +78,8 @@ struct GridStepInput {
   /// impulses its first solution needed), or after it (false: the velocities change by
   /// the friction impulse after the solve).
   bool friction_in_solve = false;
+  /// With friction in the solve: LaggedFriction::eps [m/s] (shot.friction_stick_speed).
+  double friction_stick_speed = 1e-3;
   /// With friction in the solve (null: none): each node's Coulomb bound to start from
   /// (empty: none; the step is solved without friction first), and on return those its
   /// solution needs. A step solved again after its groups were joined starts from the

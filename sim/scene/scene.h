@@ -91,6 +91,10 @@ struct ShotSettings {
   /// Implicit grid step: Coulomb friction at the colliders inside the solve (a lagged
   /// potential, the step solved again with the normal impulses), or after it.
   bool friction_in_solve = false;
+  /// With friction in the solve: the speed along a collider below which a node sticks
+  /// elastically (friction_potential.h's eps) [m/s]; a node held by friction creeps at most
+  /// this fast, and a larger one makes the solves easier.
+  double friction_stick_speed = 1e-3;
   /// What a frame whose integrity check failed (material through a shell, shells crossing,
   /// points inside a collider, non-finite state) does: warn and go on, or stop (exit 1).
   enum class OnIntegrityFailure { Warn, Stop } on_integrity_failure = OnIntegrityFailure::Warn;

@@ -36,6 +36,7 @@ void ImplicitGridStage::run(StepContext& c) {
   in.first_bulk = static_cast<std::uint32_t>(c.shell_table.size());
   in.factorise = shot.implicit_preconditioner == ImplicitPreconditioner::Factorised;
   in.friction_in_solve = shot.friction_in_solve;
+  in.friction_stick_speed = shot.friction_stick_speed;
   if (kls_.size() != c.grid_shells.size()) {
     kls_.resize(c.grid_shells.size());
     for (std::size_t s = 0; s < kls_.size(); ++s)
