@@ -345,9 +345,18 @@ class GridObjective final : public ImplicitObjective {
         break;
       }
     }
+    // A step solved again starts from its last solution: a wall also holds the components
+    // that solution drove into it or held (the walls after the step clamp the solved ones;
+    // the held set only grows, so the solves settle).
+    const bool again = in_.start && i / kBlockNodes < in_.start->size();
+    Vec3d s = Vec3d::Constant(again ? 0.0 : std::nan(""));
+    if (again) {
+      const Real* sv = (*in_.start)[i / kBlockNodes][i % kBlockNodes].v;
+      s = Vec3d(sv[0], sv[1], sv[2]);
+    }
     for (int a = 0; a < 3; ++a) {
-      const bool low = c[a] < in_.wall_cells && v[a] < 0;
-      const bool high = c[a] > in_.domain_cells[a] - in_.wall_cells && v[a] > 0;
+      const bool low = c[a] < in_.wall_cells && (v[a] < 0 || s[a] <= 0);
+      const bool high = c[a] > in_.domain_cells[a] - in_.wall_cells && (v[a] > 0 || s[a] >= 0);
       if (low || high) {
         v[a] = 0;
         fixed_[3 * i + a] = 1;

@@ -11,11 +11,11 @@
 //
 // Constraints, projected inside CG (newton.h): nodes without mass; the domain walls
 // (a component whose predicted velocity v^n + dt g points into a wall within kWallCells is
-// held at 0); colliders, at the nodes within reach of material (collider_reach.h), from
-// the predicted velocity: sticky nodes take the collider's
-// velocity, slip and separate (approaching) nodes keep the collider's normal velocity and
-// move freely along the surface. Coulomb friction follows the solve at those nodes, with
-// the normal impulse the constraint applied (the explicit collider stage takes it from the
+// held at 0, and, in a step solved again, one the last solution drove into it); colliders, at the
+// nodes within reach of material (collider_reach.h), from the predicted velocity: sticky nodes take
+// the collider's velocity, slip and separate (approaching) nodes keep the collider's normal
+// velocity and move freely along the surface. Coulomb friction follows the solve at those nodes,
+// with the normal impulse the constraint applied (the explicit collider stage takes it from the
 // approach speed, which the constraint has already stopped here), or is a term of the
 // objective (friction_in_solve).
 //
@@ -67,8 +67,9 @@ struct GridStepInput {
   std::vector<Vec3>* slot_out = nullptr;
   /// A solution of the same step to start Newton from (null: v^n + dt g): the nodes'
   /// velocities (in v), and the slots' from slots->slot_start; projected onto the
-  /// constraints. The step solved again after its groups were joined (field_slots.h)
-  /// starts where the last solve ended.
+  /// constraints. The step solved again after its groups were joined (field_slots.h), or
+  /// after its solution drove nodes into a wall the prediction left free, starts where the
+  /// last solve ended; the walls then also hold what that solution drove into them.
   const std::vector<std::array<GridNode, kBlockNodes>>* start = nullptr;
   /// With shells: `factorised` factorises the tangent on the nodes the shells reach
   /// (Jacobi elsewhere); `block_jacobi` keeps its diagonal.

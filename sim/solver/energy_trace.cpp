@@ -42,12 +42,19 @@ void EnergyTrace::after(const StepContext& c, std::string_view stage) {
       const double d = std::abs(now[i].total() - bodies_[i].total());
       if (d > most) most = d, k = i;
     }
+    const BodyEnergy &a = bodies_[k], &b = now[k];
     std::fprintf(stderr,
                  "energy t %.6f s %-18s %+.4e J (most in '%s': kinetic %+.3e, stored %+.3e, "
-                 "potential %+.3e J)\n",
-                 c.time, std::string(stage).c_str(), e - last_, now[k].name.c_str(),
-                 now[k].kinetic - bodies_[k].kinetic, now[k].stored - bodies_[k].stored,
-                 now[k].potential - bodies_[k].potential);
+                 "potential %+.3e J)",
+                 c.time, std::string(stage).c_str(), e - last_, b.name.c_str(),
+                 b.kinetic - a.kinetic, b.stored - a.stored, b.potential - a.potential);
+    // A shell's stored energy: its membrane and bending energy, and its contact particles'.
+    if (b.shell) {
+      const double membrane = b.membrane - a.membrane, bending = b.bending - a.bending;
+      std::fprintf(stderr, " [membrane %+.3e, bending %+.3e, contact %+.3e J]", membrane, bending,
+                   b.stored - a.stored - membrane - bending);
+    }
+    std::fputc('\n', stderr);
   }
   last_ = e;
   bodies_ = std::move(now);

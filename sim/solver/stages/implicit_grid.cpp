@@ -11,6 +11,34 @@ namespace shellmpm {
 namespace {
 /// Solves again a step at most this often with the groups its solution joined.
 constexpr int kMaxRegroups = 3;
+/// And at most this often with the walls holding what its solution drove into them (the
+/// held set grows each time: a block pressed onto the floor's band took four).
+constexpr int kMaxWallSolves = 6;
+
+/// Whether the walls after the step (StepContext::apply_walls) would change a solved
+/// velocity by more than tol [m/s]: motion the solve never saw, which strains a stiff
+/// shell whose stencils reach into the walls (a can on a bed of sand one cell deep).
+bool drives_into_walls(const StepContext& c, double tol) {
+  const SparseGrid& grid = c.grid;
+  for (std::size_t b = 0; b < grid.num_grid_blocks(); ++b) {
+    const Vec3i corner = unpack_block(grid.gblock_key[b]) * kBlockSize;
+    bool clear = true;
+    for (int a = 0; a < 3; ++a)
+      clear = clear && corner[a] >= kWallCells &&
+              corner[a] + kBlockSize - 1 <= c.domain_cells[a] - kWallCells;
+    if (clear) continue;
+    for (int n = 0; n < kBlockNodes; ++n) {
+      const GridNode& nd = grid.gblock_nodes[b][std::size_t(n)];
+      if (!(nd.m > 0)) continue;
+      const Vec3i p = corner + Vec3i(n >> 4, (n >> 2) & 3, n & 3);
+      for (int a = 0; a < 3; ++a)
+        if ((p[a] < kWallCells && nd.v[a] < -tol) ||
+            (p[a] > c.domain_cells[a] - kWallCells && nd.v[a] > tol))
+          return true;
+    }
+  }
+  return false;
+}
 }  // namespace
 
 bool ImplicitGridStage::needed(const Scene& s) {
@@ -58,7 +86,7 @@ void ImplicitGridStage::run(StepContext& c) {
   std::vector<Vec3> slot_vel;
   std::vector<std::array<GridNode, kBlockNodes>> before;  // the grid as P2G left it
   std::vector<std::array<GridNode, kBlockNodes>> solved;  // the last solve's velocities
-  int regroups = 0;
+  int regroups = 0, walled = 0;
   std::vector<double> friction_bounds;  // friction in the solve: the last solve's bounds
   in.friction_bounds = &friction_bounds;
   const auto pose_slots = [&]() {
@@ -88,7 +116,7 @@ void ImplicitGridStage::run(StepContext& c) {
       shells->set_colliders(&c.colliders);
       in.shells = shells.get();
     }
-    if (in.slots && regroups == 0) before = c.grid.gblock_nodes;
+    if (regroups == 0 && walled == 0) before = c.grid.gblock_nodes;
     double work = 0;
     in.collider_work = &work;
     const NewtonReport rep = implicit_grid_step(in, dt, opt);
@@ -102,6 +130,15 @@ void ImplicitGridStage::run(StepContext& c) {
       c.grid.gblock_nodes = before;
       in.start = &solved;
       pose_slots();
+      continue;
+    }
+    if (rep.converged && walled < kMaxWallSolves && drives_into_walls(c, shot.implicit_tolerance)) {
+      // Solved again with the walls holding what the solution drove into them.
+      ++walled;
+      solved.swap(c.grid.gblock_nodes);
+      c.grid.gblock_nodes = before;
+      in.start = &solved;
+      if (in.slots) pose_slots();
       continue;
     }
     if (rep.converged) {
