@@ -53,6 +53,39 @@ Vec3d momentum(const Solver& s) {
   return fs.momentum;
 }
 
+/// A grid step of the solver's particles, set up as the implicit_grid stage does: the
+/// grid binned, a P2G of mass and momentum only (dt), the models in double; `in` points at
+/// them.
+struct GridStepSetup {
+  SparseGrid grid;
+  std::vector<ConstitutiveModelT<double>> models;
+  GridStepInput in;
+  GridStepSetup(Solver& solver, double dt, bool mls) {
+    const Scene& s = solver.scene();
+    ParticleSet& p = solver.particles();
+    grid.setup(s.shot.dx, s.shot.domain_min);
+    grid.bin(p.x, true);
+    TransferParams tp;
+    tp.dt = Real(dt);
+    tp.mls = mls;
+    tp.serial = true;
+    tp.stress = false;
+    tp.models = &solver.models();
+    tp.densities = &solver.densities();
+    particles_to_grid(p, grid, tp);
+    for (const MaterialDesc& m : s.materials)
+      models.push_back(ConstitutiveModelT<double>::from_desc(m));
+    in.particles = &p;
+    in.grid = &grid;
+    in.models = &models;
+    in.densities = &solver.densities();
+    in.gravity = s.shot.gravity;
+    in.domain_cells = Vec3i(20, 20, 20);
+    in.mls = mls;
+    in.serial = true;
+  }
+};
+
 }  // namespace
 
 TEST_CASE("implicit grid: the objective's gradient matches finite differences", "[implicit]") {
@@ -62,31 +95,9 @@ TEST_CASE("implicit grid: the objective's gradient matches finite differences", 
     Solver solver(s);
     ParticleSet& p = solver.particles();
     stir(p);
-    SparseGrid grid;
-    grid.setup(s.shot.dx, s.shot.domain_min);
-    grid.bin(p.x, true);
-    TransferParams tp;
-    tp.dt = Real(0.01);
-    tp.mls = tr == Transfer::Mls;
-    tp.serial = true;
-    tp.stress = false;
-    tp.models = &solver.models();
-    tp.densities = &solver.densities();
-    particles_to_grid(p, grid, tp);
-    std::vector<ConstitutiveModelT<double>> models;
-    for (const MaterialDesc& m : s.materials)
-      models.push_back(ConstitutiveModelT<double>::from_desc(m));
-    GridStepInput in;
-    in.particles = &p;
-    in.grid = &grid;
-    in.models = &models;
-    in.densities = &solver.densities();
-    in.gravity = s.shot.gravity;
-    in.domain_cells = Vec3i(20, 20, 20);
-    in.mls = tp.mls;
-    in.serial = true;
+    GridStepSetup setup(solver, 0.01, tr == Transfer::Mls);
     VecXd u0, g, d;
-    const auto obj = grid_objective(in, 0.01, u0);
+    const auto obj = grid_objective(setup.in, 0.01, u0);
     d.resize(u0.size());
     for (Eigen::Index k = 0; k < d.size(); ++k) d[k] = std::sin(1.3 * k);
     obj->project(d);
@@ -255,27 +266,9 @@ TEST_CASE(
     p.x[q].y() -= Real(0.24);  // the block from 0.06 to 0.26 m
     p.v[q] = Vec3(0, p.x[q].y() < Real(0.12) ? Real(1) : Real(-4), 0);
   }
-  SparseGrid grid;
-  grid.setup(s.shot.dx, s.shot.domain_min);
-  grid.bin(p.x, true);
-  TransferParams tp;
-  tp.dt = Real(1.0 / 24);
-  tp.serial = true;
-  tp.stress = false;
-  tp.models = &solver.models();
-  tp.densities = &solver.densities();
-  particles_to_grid(p, grid, tp);
-  std::vector<ConstitutiveModelT<double>> models;
-  for (const MaterialDesc& m : s.materials)
-    models.push_back(ConstitutiveModelT<double>::from_desc(m));
-  GridStepInput in;
-  in.particles = &p;
-  in.grid = &grid;
-  in.models = &models;
-  in.densities = &solver.densities();
-  in.gravity = s.shot.gravity;
-  in.domain_cells = Vec3i(20, 20, 20);
-  in.serial = true;
+  GridStepSetup setup(solver, 1.0 / 24, false);
+  SparseGrid& grid = setup.grid;
+  GridStepInput& in = setup.in;
   NewtonOptions opt;
   opt.max_iterations = 200;
   // The wall nodes' velocity components into the floor beyond the tolerance, and the
